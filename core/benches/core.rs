@@ -1,0 +1,4 @@
+//! Core micro-benchmarks (divan).
+fn main() {
+    divan::main();
+}

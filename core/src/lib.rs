@@ -1,0 +1,4 @@
+//! lucent-core: point-based subsurface scattering, `#![no_std]` + `alloc`.
+#![no_std]
+
+extern crate alloc;

@@ -1,0 +1,1 @@
+//! Rays and the bounding volume hierarchy used for shadow rays.

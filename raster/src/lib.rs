@@ -1,0 +1,27 @@
+//! lucent-raster: turns a scene into an image, shading every translucent pixel through
+//! `lucent-core`.
+//!
+//! The pipeline, one module per stage:
+//!
+//! | stage | module |
+//! |---|---|
+//! | scene file, OBJ meshes, textures | [`scene`], [`texture`] |
+//! | blue-noise irradiance samples | [`sampling`] |
+//! | shadow rays | [`geometry`] |
+//! | fixed-point rasterisation, visibility | [`raster`], [`camera`] |
+//! | lights and irradiance | [`lights`] |
+//! | shading through the core | [`shade`], [`render`] |
+//! | PNG / EXR / PLY output, image comparison | [`output`] |
+//! | the `lucent` command | [`cli`] |
+
+pub mod camera;
+pub mod cli;
+pub mod geometry;
+pub mod lights;
+pub mod output;
+pub mod raster;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+pub mod shade;
+pub mod texture;

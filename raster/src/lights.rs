@@ -1,0 +1,1 @@
+//! Light sources and the irradiance they deliver, with shadows.

@@ -1,0 +1,1 @@
+//! Output files: PNG, OpenEXR, baked sample sets (PLY), and image comparison.

@@ -1,0 +1,1 @@
+//! Fixed-point scanline rasterisation into a supersampled visibility buffer.

@@ -1,0 +1,1 @@
+//! The render pipeline: samples → irradiance → cache → rasterise → shade.

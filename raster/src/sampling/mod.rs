@@ -1,0 +1,1 @@
+//! Blue-noise irradiance sample placement over triangle meshes.

@@ -1,0 +1,1 @@
+//! Shading a visible surface point: translucent through the core, opaque Lambert.
