@@ -1,0 +1,252 @@
+//! The one traversal behind the hierarchical (JB02), local-global (LM07) and edge-aware (N10)
+//! queries, eight nodes or eight samples per step.
+//!
+//! A stack holds internal nodes whose children are still to be examined. Popping a node
+//! examines all its children at once in 8 lanes:
+//!
+//! 1. distance² from x to each child's bounds (`dmin2`, 0 inside) and to its centroid;
+//! 2. **aggregate** (JB02): x outside the bounds, the bounds clear of the α-ball (split modes,
+//!    LM07's refinement rule), and ΔΩ = A/|x − P|² < ε → add Rd(|x − P|)·flux;
+//! 3. **cull**: of the rest, a child is skipped (never one touching the α-ball) when, in every
+//!    channel, its contribution bound Rd(dmin)·flux (Rd is decreasing) is at most
+//!    `tolerance × (sum so far) × A_child / A_total`. Culled subtrees are disjoint and the
+//!    running sum never exceeds the result, so all culled work together is at most
+//!    `tolerance × result`. (A first version compared each subtree with `tolerance × sum`
+//!    alone; thousands of culled subtrees then added up to 3% error at ε = 0.001.)
+//! 4. open the others: leaves are summed at once (one 8-lane batch), internal children are
+//!    pushed, the nearest last so that it is popped first and the running sum grows fast.
+//!
+//! In the split modes a leaf touching the α-ball evaluates the kernel w per sample: the global
+//! sum gets (1 − w)·Rd·flux and, for N10, the local irradiance gets w·Rd·flux over w·Rd·A.
+//! Modes are const generics, so each is compiled without the others' work.
+
+use glam::Vec3;
+
+use super::{COUNT_MASK, IrradianceCache, LEAF_BIT, MAX_DEPTH};
+use crate::kernel::Kernel;
+use crate::lanes::{LANES, Lanes, Mask};
+use crate::profile::Profile;
+use crate::stats::StatsSink;
+
+/// JB02: octree sum, no smoothing.
+pub(crate) const HIERARCHICAL: u8 = 0;
+/// LM07: (1 − w)-weighted global sum.
+pub(crate) const LOCAL_GLOBAL: u8 = 1;
+/// N10: as LM07, plus the kernel-weighted local irradiance sums.
+pub(crate) const EDGE_AWARE: u8 = 2;
+
+/// Room for the deepest tree: each level leaves at most 7 siblings on the stack.
+const STACK_SIZE: usize = (LANES - 1) * MAX_DEPTH + LANES;
+
+/// Traversal parameters (validated by the caller).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Params {
+    pub epsilon: f32,
+    pub cull_tolerance: f32,
+    pub kernel: Kernel,
+}
+
+/// What a traversal returns, per channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Sums {
+    /// Σ Rd·E·A (hierarchical) or Σ (1 − w)·Rd·E·A (split modes).
+    pub global: Vec3,
+    /// N10: Σ w·Rd·E·A.
+    pub local_flux: Vec3,
+    /// N10: Σ w·Rd·A.
+    pub local_weight: Vec3,
+}
+
+struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
+    cache: &'a IrradianceCache,
+    profile: &'a Profile,
+    kernel: Kernel,
+    x: [L; 3],
+    global: [L; 3],
+    local_flux: [L; 3],
+    local_weight: [L; 3],
+    stats: &'a mut S,
+}
+
+impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
+    /// Sums one leaf's samples. `near`: the leaf's bounds meet the α-ball.
+    #[inline(always)]
+    fn leaf(&mut self, node: usize, near: bool) {
+        let nodes = &self.cache.nodes;
+        let s = &self.cache.samples;
+        let first = nodes.first[node] as usize;
+        let count = nodes.info[node] & COUNT_MASK;
+        let valid = Mask::first(count);
+        self.stats.samples(count);
+        let px = L::load(&s.pos_x[first..]) - self.x[0];
+        let py = L::load(&s.pos_y[first..]) - self.x[1];
+        let pz = L::load(&s.pos_z[first..]) - self.x[2];
+        let r2 = px * px + py * py + pz * pz;
+        let rd = self.profile.rd_lanes(r2);
+        let flux = [
+            L::load(&s.flux_r[first..]).keep(valid),
+            L::load(&s.flux_g[first..]).keep(valid),
+            L::load(&s.flux_b[first..]).keep(valid),
+        ];
+        if MODE == HIERARCHICAL || !near {
+            for c in 0..3 {
+                self.global[c] = self.global[c] + rd[c] * flux[c];
+            }
+            return;
+        }
+        let w = self.kernel.weight_lanes(r2);
+        let one_minus_w = L::splat(1.0) - w;
+        let area = if MODE == EDGE_AWARE {
+            L::load(&s.area[first..]).keep(valid)
+        } else {
+            L::splat(0.0)
+        };
+        for c in 0..3 {
+            let t = rd[c] * flux[c];
+            self.global[c] = self.global[c] + t * one_minus_w;
+            if MODE == EDGE_AWARE {
+                self.local_flux[c] = self.local_flux[c] + t * w;
+                self.local_weight[c] = self.local_weight[c] + rd[c] * area * w;
+            }
+        }
+    }
+
+    fn run(&mut self, params: &Params) {
+        let nodes = &self.cache.nodes;
+        if self.cache.node_len == 0 {
+            return;
+        }
+        if nodes.info[0] & LEAF_BIT != 0 {
+            self.leaf(0, true);
+            return;
+        }
+        let zero = L::splat(0.0);
+        let eps = L::splat(params.epsilon);
+        let alpha2 = L::splat(if MODE == HIERARCHICAL {
+            0.0
+        } else {
+            self.kernel.radius2()
+        });
+        let tolerance = params.cull_tolerance;
+        let total_area = nodes.area[0].max(f32::MIN_POSITIVE);
+        let [xx, xy, xz] = self.x;
+
+        let mut stack = [0u32; STACK_SIZE];
+        let mut sp = 1usize; // stack[0] = root
+        while sp > 0 {
+            sp -= 1;
+            let node = stack[sp] as usize;
+            self.stats.node();
+            let first = nodes.first[node] as usize;
+            let valid = Mask::first(nodes.info[node] & COUNT_MASK);
+            let load = |col: &[f32]| L::load(&col[first..]);
+
+            let dx = (load(&nodes.min_x) - xx)
+                .max(xx - load(&nodes.max_x))
+                .max(zero);
+            let dy = (load(&nodes.min_y) - xy)
+                .max(xy - load(&nodes.max_y))
+                .max(zero);
+            let dz = (load(&nodes.min_z) - xz)
+                .max(xz - load(&nodes.max_z))
+                .max(zero);
+            let dmin2 = dx * dx + dy * dy + dz * dz;
+            let cx = load(&nodes.centroid_x) - xx;
+            let cy = load(&nodes.centroid_y) - xy;
+            let cz = load(&nodes.centroid_z) - xz;
+            let dist2 = cx * cx + cy * cy + cz * cz;
+            let flux = [
+                load(&nodes.flux_r),
+                load(&nodes.flux_g),
+                load(&nodes.flux_b),
+            ];
+
+            let near = dmin2.lt(alpha2); // bounds meet the α-ball (never in JB02 mode)
+            let outside = zero.lt(dmin2);
+            let small = load(&nodes.area).lt(eps * dist2);
+            let aggregate = valid & outside & !near & small;
+            if aggregate.any() {
+                let rd = self.profile.rd_lanes(dist2);
+                for c in 0..3 {
+                    self.global[c] = self.global[c] + (rd[c] * flux[c]).keep(aggregate);
+                }
+                self.stats.aggregates(aggregate.0.count_ones());
+            }
+
+            let mut open = valid & !aggregate;
+            if !open.any() {
+                continue;
+            }
+            let cullable = open & !near;
+            if tolerance > 0.0 && cullable.any() {
+                let running = self.global.map(|g| g.reduce_add());
+                if running.iter().any(|&r| r > 0.0) {
+                    // Area-budgeted bound: Rd(dmin)·flux ≤ tol · running · A_node / A_total.
+                    // Culled subtrees are disjoint and running ≤ the final sum, so everything
+                    // culled adds up to at most tol × the result, per channel.
+                    let bound = self.profile.rd_lanes(dmin2);
+                    let budget = load(&nodes.area) * L::splat(tolerance / total_area);
+                    let mut negligible = Mask(0xff);
+                    for c in 0..3 {
+                        // Not (budget · running < bound · flux).
+                        negligible =
+                            negligible & !(budget * L::splat(running[c])).lt(bound[c] * flux[c]);
+                    }
+                    let culled = cullable & negligible;
+                    open = open & !culled;
+                    self.stats.culled(culled.0.count_ones());
+                }
+            }
+
+            let dmin2 = dmin2.to_array();
+            let mut nearest = (f32::INFINITY, usize::MAX);
+            let mut bits = open.0;
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let child = first + lane;
+                if nodes.info[child] & LEAF_BIT != 0 {
+                    self.leaf(child, near.0 >> lane & 1 == 1);
+                } else {
+                    if dmin2[lane] < nearest.0 {
+                        nearest = (dmin2[lane], sp);
+                    }
+                    stack[sp] = child as u32;
+                    sp += 1;
+                }
+            }
+            if nearest.1 != usize::MAX {
+                stack.swap(nearest.1, sp - 1);
+            }
+        }
+    }
+}
+
+/// Runs one traversal in mode `MODE` for the shading point `x`.
+#[inline(never)]
+pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
+    cache: &IrradianceCache,
+    profile: &Profile,
+    x: Vec3,
+    params: &Params,
+    stats: &mut S,
+) -> Sums {
+    let zero = [L::splat(0.0); 3];
+    let mut walker = Walker::<L, S, MODE> {
+        cache,
+        profile,
+        kernel: params.kernel,
+        x: [L::splat(x.x), L::splat(x.y), L::splat(x.z)],
+        global: zero,
+        local_flux: zero,
+        local_weight: zero,
+        stats,
+    };
+    walker.run(params);
+    let sum = |v: [L; 3]| Vec3::new(v[0].reduce_add(), v[1].reduce_add(), v[2].reduce_add());
+    Sums {
+        global: sum(walker.global),
+        local_flux: sum(walker.local_flux),
+        local_weight: sum(walker.local_weight),
+    }
+}

@@ -1,0 +1,279 @@
+//! `IrradianceCache::validate`: checks every structural and numerical invariant of a built
+//! cache. Tests and fuzz targets call it after every build.
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec;
+use alloc::vec::Vec;
+use core::fmt;
+
+use super::{COUNT_MASK, IrradianceCache, LEAF_BIT, LEAF_CAPACITY, MAX_DEPTH};
+use crate::lanes::LANES;
+
+/// A broken invariant, described.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ValidationError(pub String);
+
+impl fmt::Display for ValidationError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "invalid irradiance cache: {}", self.0)
+    }
+}
+
+impl core::error::Error for ValidationError {}
+
+macro_rules! ensure {
+    ($cond:expr, $($msg:tt)*) => {
+        if !$cond {
+            return Err(ValidationError(format!($($msg)*)));
+        }
+    };
+}
+
+/// |a − b| within a relative tolerance suited to f32 sums of a few hundred terms.
+fn close(a: f32, b: f64) -> bool {
+    ((a as f64) - b).abs() <= 1e-5 * b.abs().max(a.abs() as f64) + 1e-30
+}
+
+impl IrradianceCache {
+    /// Checks every invariant: column lengths and zero padding; breadth-first node order with
+    /// contiguous children after their parent; leaves of 1..=8 samples partitioning the
+    /// samples; depth; Morton order of the samples; and every aggregate (area, flux, tight
+    /// bounds, centroid inside the bounds) against a fresh sum of its children.
+    pub fn validate(&self) -> Result<(), ValidationError> {
+        let (n, m) = (self.len, self.node_len);
+        let s = &self.samples;
+        let d = &self.nodes;
+        for (name, col) in [
+            ("pos_x", &s.pos_x),
+            ("pos_y", &s.pos_y),
+            ("pos_z", &s.pos_z),
+            ("area", &s.area),
+            ("flux_r", &s.flux_r),
+            ("flux_g", &s.flux_g),
+            ("flux_b", &s.flux_b),
+        ] {
+            ensure!(
+                col.len() == n + LANES,
+                "sample column {name} has {} entries, expected {}",
+                col.len(),
+                n + LANES
+            );
+            ensure!(
+                col[n..].iter().all(|&v| v == 0.0),
+                "sample column {name} padding is not zero"
+            );
+        }
+        for (name, col) in [
+            ("min_x", &d.min_x),
+            ("min_y", &d.min_y),
+            ("min_z", &d.min_z),
+            ("max_x", &d.max_x),
+            ("max_y", &d.max_y),
+            ("max_z", &d.max_z),
+            ("area", &d.area),
+            ("flux_r", &d.flux_r),
+            ("flux_g", &d.flux_g),
+            ("flux_b", &d.flux_b),
+            ("centroid_x", &d.centroid_x),
+            ("centroid_y", &d.centroid_y),
+            ("centroid_z", &d.centroid_z),
+        ] {
+            ensure!(
+                col.len() == m + LANES,
+                "node column {name} has {} entries, expected {}",
+                col.len(),
+                m + LANES
+            );
+            ensure!(
+                col[m..].iter().all(|&v| v == 0.0),
+                "node column {name} padding is not zero"
+            );
+            ensure!(
+                col.iter().all(|v| v.is_finite()),
+                "node column {name} has a non-finite value"
+            );
+        }
+        ensure!(
+            d.first.len() == m + LANES && d.info.len() == m + LANES,
+            "node index columns have the wrong length"
+        );
+        ensure!(
+            d.info[m..].iter().all(|&v| v == 0),
+            "node info padding is not zero"
+        );
+        ensure!((n == 0) == (m == 0), "{n} samples but {m} nodes");
+        if n == 0 {
+            return Ok(());
+        }
+
+        for i in 0..n {
+            ensure!(
+                s.pos_x[i].is_finite() && s.pos_y[i].is_finite() && s.pos_z[i].is_finite(),
+                "sample {i} position not finite"
+            );
+            ensure!(
+                s.area[i] >= 0.0 && s.area[i].is_finite(),
+                "sample {i} area {}",
+                s.area[i]
+            );
+            for f in [s.flux_r[i], s.flux_g[i], s.flux_b[i]] {
+                ensure!(f >= 0.0 && f.is_finite(), "sample {i} flux {f}");
+            }
+        }
+
+        // Morton order.
+        let mut prev = 0u64;
+        for i in 0..n {
+            let code = self
+                .grid
+                .code(glam::Vec3::new(s.pos_x[i], s.pos_y[i], s.pos_z[i]));
+            ensure!(code >= prev, "sample {i} breaks Morton order");
+            prev = code;
+        }
+
+        // Structure: breadth-first, contiguous children, sample ranges, depth.
+        let mut range = vec![(0u32, 0u32); m];
+        let mut depth = vec![0usize; m];
+        let mut parent_seen = vec![false; m];
+        parent_seen[0] = true;
+        let mut next_child = 1u32;
+        let mut covered = vec![0u8; n];
+        for i in 0..m {
+            let info = d.info[i];
+            let count = info & COUNT_MASK;
+            ensure!(
+                info & !(COUNT_MASK | LEAF_BIT) == 0,
+                "node {i} has stray bits in info {info:#x}"
+            );
+            ensure!(
+                (1..=LEAF_CAPACITY).contains(&count),
+                "node {i} has count {count}"
+            );
+            let first = d.first[i];
+            if info & LEAF_BIT != 0 {
+                ensure!(
+                    (first + count) as usize <= n,
+                    "leaf {i} samples {first}+{count} out of range"
+                );
+                for c in &mut covered[first as usize..(first + count) as usize] {
+                    *c += 1;
+                }
+            } else {
+                ensure!(
+                    first == next_child,
+                    "node {i}: children start at {first}, expected {next_child} (breadth-first)"
+                );
+                ensure!(
+                    (first + count) as usize <= m,
+                    "node {i}: children out of range"
+                );
+                for c in first..first + count {
+                    parent_seen[c as usize] = true;
+                    depth[c as usize] = depth[i] + 1;
+                }
+                next_child += count;
+            }
+        }
+        ensure!(
+            next_child as usize == m,
+            "{} nodes but children account for {next_child}",
+            m
+        );
+        ensure!(parent_seen.iter().all(|&p| p), "a node has no parent");
+        ensure!(
+            covered.iter().all(|&c| c == 1),
+            "leaves do not partition the samples"
+        );
+        let max_depth = depth.iter().copied().max().unwrap_or(0);
+        ensure!(
+            max_depth == self.depth && max_depth <= MAX_DEPTH,
+            "depth {max_depth} (recorded {}, limit {MAX_DEPTH})",
+            self.depth
+        );
+
+        // Aggregates, bottom-up, and contiguous sample ranges.
+        for i in (0..m).rev() {
+            let info = d.info[i];
+            let (first, count) = (d.first[i] as usize, (info & COUNT_MASK) as usize);
+            let mut area = 0.0f64;
+            let mut flux = [0.0f64; 3];
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            if info & LEAF_BIT != 0 {
+                range[i] = (first as u32, (first + count) as u32);
+                for j in first..first + count {
+                    area += s.area[j] as f64;
+                    flux[0] += s.flux_r[j] as f64;
+                    flux[1] += s.flux_g[j] as f64;
+                    flux[2] += s.flux_b[j] as f64;
+                    for (a, v) in [s.pos_x[j], s.pos_y[j], s.pos_z[j]].into_iter().enumerate() {
+                        lo[a] = lo[a].min(v);
+                        hi[a] = hi[a].max(v);
+                    }
+                }
+            } else {
+                range[i] = (range[first].0, range[first + count - 1].1);
+                for c in first..first + count {
+                    if c > first {
+                        ensure!(
+                            range[c].0 == range[c - 1].1,
+                            "children of node {i} own non-contiguous samples"
+                        );
+                    }
+                    area += d.area[c] as f64;
+                    flux[0] += d.flux_r[c] as f64;
+                    flux[1] += d.flux_g[c] as f64;
+                    flux[2] += d.flux_b[c] as f64;
+                    for a in 0..3 {
+                        lo[a] = lo[a].min([d.min_x[c], d.min_y[c], d.min_z[c]][a]);
+                        hi[a] = hi[a].max([d.max_x[c], d.max_y[c], d.max_z[c]][a]);
+                    }
+                }
+            }
+            ensure!(
+                close(d.area[i], area),
+                "node {i} area {} != {area}",
+                d.area[i]
+            );
+            ensure!(
+                close(d.flux_r[i], flux[0])
+                    && close(d.flux_g[i], flux[1])
+                    && close(d.flux_b[i], flux[2]),
+                "node {i} flux does not match its children"
+            );
+            let nlo = [d.min_x[i], d.min_y[i], d.min_z[i]];
+            let nhi = [d.max_x[i], d.max_y[i], d.max_z[i]];
+            ensure!(
+                nlo == lo && nhi == hi,
+                "node {i} bounds {nlo:?}..{nhi:?} are not the tight {lo:?}..{hi:?}"
+            );
+            let c = [d.centroid_x[i], d.centroid_y[i], d.centroid_z[i]];
+            ensure!(
+                (0..3).all(|a| c[a] >= lo[a] && c[a] <= hi[a]),
+                "node {i} centroid {c:?} outside its bounds"
+            );
+        }
+        ensure!(
+            range[0] == (0, n as u32),
+            "root covers samples {:?}, expected 0..{n}",
+            range[0]
+        );
+        let mean = d.area[0] as f64 / n as f64;
+        ensure!(
+            close(self.mean_area, mean),
+            "mean area {} != {mean}",
+            self.mean_area
+        );
+        Ok(())
+    }
+}
+
+/// Helper for tests: the leaf sample counts (for statistics in benches and tests).
+#[allow(dead_code)]
+pub(crate) fn leaf_sizes(cache: &IrradianceCache) -> Vec<u32> {
+    (0..cache.node_len)
+        .filter(|&i| cache.nodes.info[i] & LEAF_BIT != 0)
+        .map(|i| cache.nodes.info[i] & COUNT_MASK)
+        .collect()
+}

@@ -1,0 +1,467 @@
+//! The classical dipole diffusion profile of Jensen, Marschner, Levoy & Hanrahan 2001 (J01,
+//! eq. 4), one colour channel, evaluated from the *squared* distance r².
+//!
+//! ```text
+//! Rd(r) = α′/(4π) · [ z_r (σ_tr d_r + 1) e^(−σ_tr d_r) / d_r³ + z_v (σ_tr d_v + 1) e^(−σ_tr d_v) / d_v³ ]
+//! d_r = √(r² + z_r²),  d_v = √(r² + z_v²),  z_r = 1/σ_t′,  z_v = z_r (1 + 4A/3),
+//! A = (1 + F_dr)/(1 − F_dr),  σ_tr = √(3 σ_a σ_t′),  α′ = σ_s′/σ_t′
+//! ```
+//!
+//! Rd has units 1/length² (it is a density over the surface): M_o(x) = ∫ Rd(|x − y|) E(y) dA.
+//! It is strictly decreasing in r, which the cache's culling relies on.
+
+use crate::error::ParamError;
+use crate::fresnel;
+use crate::lanes::Lanes;
+use crate::math;
+
+/// Squared distances are clamped to this before evaluation so that d³ overflows to +∞ (and Rd
+/// to 0) instead of producing ∞ · 0 = NaN for absurdly distant samples.
+const MAX_R2: f32 = 1e36;
+
+/// The boundary term A = (1 + F_dr)/(1 − F_dr) with the J01 internal F_dr fit.
+pub fn boundary_term(eta: f64) -> f64 {
+    let fdr = fresnel::diffuse_reflectance_internal_fit(eta);
+    (1.0 + fdr) / (1.0 - fdr)
+}
+
+/// Total diffuse reflectance ∫ Rd dA of a semi-infinite medium in closed form (J01 eq. 5 as
+/// quoted on the reference sheet §1):
+/// Rd_total(α′) = (α′/2)(1 + e^(−(4/3) A √(3(1−α′)))) e^(−√(3(1−α′))).
+/// Monotone increasing on [0, 1], from 0 to 1.
+pub fn total_reflectance(albedo: f64, eta: f64) -> f64 {
+    let a = boundary_term(eta);
+    let s = math::sqrt64(3.0 * (1.0 - albedo).max(0.0));
+    0.5 * albedo * (1.0 + math::exp64(-(4.0 / 3.0) * a * s)) * math::exp64(-s)
+}
+
+/// Rd_total as a function of s = √(3(1 − α′)), in which it is smooth (in α′ it has infinite
+/// slope at α′ = 1): (1 − s²/3)/2 · (1 + e^(−4As/3)) · e^(−s), decreasing on [0, √3].
+fn total_reflectance_of_s(s: f64, eta: f64) -> f64 {
+    let a = boundary_term(eta);
+    0.5 * (1.0 - s * s / 3.0) * (1.0 + math::exp64(-(4.0 / 3.0) * a * s)) * math::exp64(-s)
+}
+
+/// The reduced albedo α′ whose total diffuse reflectance is `kd` (JB02's inversion), by
+/// bisection in s = √(3(1 − α′)) on [0, √3] in double precision (64 halvings: exact to
+/// rounding; bisecting in α′ itself loses digits near α′ = 1 where the slope is infinite).
+/// `kd` must lie in (0, 1); callers validate.
+pub fn albedo_from_total_reflectance(kd: f64, eta: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0_f64, math::sqrt64(3.0));
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if total_reflectance_of_s(mid, eta) > kd {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let s = 0.5 * (lo + hi);
+    1.0 - s * s / 3.0
+}
+
+/// One channel of the dipole, with everything precomputed for evaluation from r².
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dipole {
+    sigma_tr: f32,
+    z_r: f32,
+    z_v: f32,
+    z_r2: f32,
+    z_v2: f32,
+    /// α′ / (4π).
+    scale: f32,
+    /// α′ in double precision: 1 − α′ must stay exact for albedos near 1.
+    albedo: f64,
+    sigma_t: f32,
+    rd_zero: f32,
+    rd_total: f32,
+}
+
+fn check_positive(name: &'static str, v: f32) -> Result<(), ParamError> {
+    if !v.is_finite() {
+        Err(ParamError::NotFinite { name, value: v })
+    } else if v <= 0.0 {
+        Err(ParamError::NotPositive { name, value: v })
+    } else {
+        Ok(())
+    }
+}
+
+/// Validates a relative index of refraction.
+pub(crate) fn check_eta(eta: f32) -> Result<(), ParamError> {
+    if !eta.is_finite() {
+        Err(ParamError::NotFinite {
+            name: "eta",
+            value: eta,
+        })
+    } else if eta < 1.0 {
+        Err(ParamError::EtaBelowOne { value: eta })
+    } else {
+        Ok(())
+    }
+}
+
+impl Dipole {
+    /// From absorption σ_a and reduced scattering σ_s′ (both per scene unit) and η.
+    pub fn from_coefficients(
+        sigma_a: f32,
+        sigma_s_prime: f32,
+        eta: f32,
+    ) -> Result<Self, ParamError> {
+        check_positive("sigma_a", sigma_a)?;
+        check_positive("sigma_s_prime", sigma_s_prime)?;
+        check_eta(eta)?;
+        let sigma_t = sigma_a as f64 + sigma_s_prime as f64;
+        let albedo = sigma_s_prime as f64 / sigma_t;
+        Self::from_albedo_and_extinction(albedo, sigma_t, eta)
+    }
+
+    /// From the reduced albedo α′ ∈ (0, 1) and the reduced extinction σ_t′ = 1/ℓ_u (per scene
+    /// unit). The scaling law of the reference sheet: for fixed α′ and η every length of the
+    /// profile is proportional to ℓ_u.
+    pub fn from_albedo_and_extinction(
+        albedo: f64,
+        sigma_t: f64,
+        eta: f32,
+    ) -> Result<Self, ParamError> {
+        check_eta(eta)?;
+        if !(albedo > 0.0 && albedo <= 1.0) {
+            return Err(ParamError::OutOfRange {
+                name: "albedo",
+                value: albedo as f32,
+            });
+        }
+        if !(sigma_t.is_finite() && sigma_t > 0.0) {
+            return Err(ParamError::NotPositive {
+                name: "sigma_t",
+                value: sigma_t as f32,
+            });
+        }
+        let a = boundary_term(eta as f64);
+        let z_r = 1.0 / sigma_t;
+        let z_v = z_r * (1.0 + 4.0 * a / 3.0);
+        let sigma_tr = sigma_t * math::sqrt64(3.0 * (1.0 - albedo));
+        let scale = albedo / (4.0 * core::f64::consts::PI);
+        let term = |z: f64| z * (sigma_tr * z + 1.0) * math::exp64(-sigma_tr * z) / (z * z * z);
+        let rd_zero = scale * (term(z_r) + term(z_v));
+        let d = Dipole {
+            sigma_tr: sigma_tr as f32,
+            z_r: z_r as f32,
+            z_v: z_v as f32,
+            z_r2: (z_r * z_r) as f32,
+            z_v2: (z_v * z_v) as f32,
+            scale: scale as f32,
+            albedo,
+            sigma_t: sigma_t as f32,
+            rd_zero: rd_zero as f32,
+            rd_total: total_reflectance(albedo, eta as f64) as f32,
+        };
+        // Both source depths squared must be normal floats with headroom for r² (else Rd(0)
+        // overflows or the profile underflows to nothing), and Rd(0) must be finite.
+        let ok = |v: f32| v.is_finite() && v >= f32::MIN_POSITIVE;
+        if !(ok(d.z_r2) && ok(d.z_v2) && d.z_v2 < 1e30 && d.rd_zero.is_finite() && d.rd_zero > 0.0)
+        {
+            return Err(ParamError::OutOfRange {
+                name: "mean free path",
+                value: z_r as f32,
+            });
+        }
+        Ok(d)
+    }
+
+    /// Rd(r) from r² (units 1/length²).
+    #[inline]
+    pub fn rd(&self, r2: f32) -> f32 {
+        let r2 = r2.min(MAX_R2);
+        let dr = math::sqrt(r2 + self.z_r2);
+        let dv = math::sqrt(r2 + self.z_v2);
+        let er = math::exp(-self.sigma_tr * dr);
+        let ev = math::exp(-self.sigma_tr * dv);
+        let tr = self.z_r * (self.sigma_tr * dr + 1.0) * er / (dr * (r2 + self.z_r2));
+        let tv = self.z_v * (self.sigma_tr * dv + 1.0) * ev / (dv * (r2 + self.z_v2));
+        self.scale * (tr + tv)
+    }
+
+    /// Rd on eight squared distances at once; the same formula as [`Dipole::rd`].
+    #[inline(always)]
+    pub fn rd_lanes<L: Lanes>(&self, r2: L) -> L {
+        let r2 = r2.min(L::splat(MAX_R2));
+        let sigma = L::splat(self.sigma_tr);
+        let one = L::splat(1.0);
+        let dr2 = r2 + L::splat(self.z_r2);
+        let dv2 = r2 + L::splat(self.z_v2);
+        let dr = dr2.sqrt();
+        let dv = dv2.sqrt();
+        let er = (L::splat(0.0) - sigma * dr).exp_nonpositive();
+        let ev = (L::splat(0.0) - sigma * dv).exp_nonpositive();
+        let tr = L::splat(self.z_r) * (sigma * dr + one) * er / (dr * dr2);
+        let tv = L::splat(self.z_v) * (sigma * dv + one) * ev / (dv * dv2);
+        L::splat(self.scale) * (tr + tv)
+    }
+
+    /// Rd(0), the peak of the profile (precomputed in double precision).
+    pub fn rd_zero(&self) -> f32 {
+        self.rd_zero
+    }
+    /// Rd_total = ∫ Rd dA (closed form, double precision).
+    pub fn total_reflectance(&self) -> f32 {
+        self.rd_total
+    }
+    /// Reduced albedo α′ = σ_s′/σ_t′ (double precision, so that 1 − α′ is exact near 1).
+    pub fn albedo(&self) -> f64 {
+        self.albedo
+    }
+    /// Reduced extinction σ_t′ (per scene unit).
+    pub fn sigma_t(&self) -> f32 {
+        self.sigma_t
+    }
+    /// Effective transport coefficient σ_tr (per scene unit): Rd falls like e^(−σ_tr r).
+    pub fn sigma_tr(&self) -> f32 {
+        self.sigma_tr
+    }
+    /// Mean free path ℓ_u = 1/σ_t′ (N10's ℓ_u).
+    pub fn mean_free_path(&self) -> f32 {
+        self.z_r
+    }
+    /// Diffuse mean free path ℓ_d = 1/σ_tr.
+    pub fn diffuse_mean_free_path(&self) -> f32 {
+        1.0 / self.sigma_tr
+    }
+    /// Absorption σ_a = (1 − α′) σ_t′.
+    pub fn sigma_a(&self) -> f32 {
+        ((1.0 - self.albedo) * self.sigma_t as f64) as f32
+    }
+    /// Reduced scattering σ_s′ = α′ σ_t′.
+    pub fn sigma_s_prime(&self) -> f32 {
+        (self.albedo * self.sigma_t as f64) as f32
+    }
+}
+
+/// The dipole with ℓ_u = 1 in double precision: the unitless shape that the scaling law
+/// stretches, Rd_ℓ(r) = Rd_1(r/ℓ)/ℓ². Used by the local-integral quadrature.
+#[derive(Clone, Copy, Debug)]
+pub struct UnitDipole {
+    sigma_tr: f64,
+    z_v: f64,
+    scale: f64,
+}
+
+impl UnitDipole {
+    /// For reduced albedo α′ and relative index η.
+    pub fn new(albedo: f64, eta: f64) -> Self {
+        UnitDipole {
+            sigma_tr: math::sqrt64(3.0 * (1.0 - albedo).max(0.0)),
+            z_v: 1.0 + 4.0 * boundary_term(eta) / 3.0,
+            scale: albedo / (4.0 * core::f64::consts::PI),
+        }
+    }
+
+    /// Rd_1(ρ) for ρ in units of ℓ_u.
+    pub fn rd(&self, rho: f64) -> f64 {
+        let term = |z: f64| {
+            let d2 = rho * rho + z * z;
+            let d = math::sqrt64(d2);
+            z * (self.sigma_tr * d + 1.0) * math::exp64(-self.sigma_tr * d) / (d * d2)
+        };
+        self.scale * (term(1.0) + term(self.z_v))
+    }
+
+    /// σ_tr in units of 1/ℓ_u.
+    pub fn sigma_tr(&self) -> f64 {
+        self.sigma_tr
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quadrature::GaussLegendre;
+
+    /// Whole milk, red channel (reference sheet §1): σ_s′ = 2.55, σ_a = 0.0011 per mm, η 1.3.
+    fn milk_red() -> Dipole {
+        Dipole::from_coefficients(0.0011, 2.55, 1.3).unwrap()
+    }
+
+    #[test]
+    fn rd_zero_matches_reference_value() {
+        let d = milk_red();
+        assert!((d.rd_zero() - 0.5430).abs() < 5e-4, "{}", d.rd_zero());
+        assert!((d.rd(0.0) - d.rd_zero()).abs() / d.rd_zero() < 1e-6);
+    }
+
+    /// Rd written out independently in f64 straight from the formula (no precomputed terms).
+    fn rd_reference(sigma_a: f64, sigma_s: f64, eta: f64, r: f64) -> f64 {
+        let st = sigma_a + sigma_s;
+        let alpha = sigma_s / st;
+        let str_ = (3.0 * sigma_a * st).sqrt();
+        let fdr = -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta;
+        let a = (1.0 + fdr) / (1.0 - fdr);
+        let zr = 1.0 / st;
+        let zv = zr * (1.0 + 4.0 * a / 3.0);
+        let dr = (r * r + zr * zr).sqrt();
+        let dv = (r * r + zv * zv).sqrt();
+        alpha / (4.0 * core::f64::consts::PI)
+            * (zr * (str_ * dr + 1.0) * (-str_ * dr).exp() / (dr * dr * dr)
+                + zv * (str_ * dv + 1.0) * (-str_ * dv).exp() / (dv * dv * dv))
+    }
+
+    #[test]
+    fn rd_matches_independent_f64_formula() {
+        for &(sa, ss, eta) in &[
+            (0.0011, 2.55, 1.3),
+            (0.032, 0.74, 1.3),
+            (0.0021, 2.19, 1.5),
+            (1.45, 0.03, 1.3),
+        ] {
+            let d = Dipole::from_coefficients(sa as f32, ss as f32, eta as f32).unwrap();
+            for i in 0..200 {
+                let r = 0.001 * (1.07f64).powi(i);
+                let want = rd_reference(sa, ss, eta, r);
+                let got = d.rd((r * r) as f32) as f64;
+                if want > 1e-30 {
+                    assert!(((got - want) / want).abs() < 2e-5, "r {r}: {got} vs {want}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rd_is_strictly_decreasing_and_vanishes_far_away() {
+        let d = milk_red();
+        let mut prev = f32::INFINITY;
+        for i in 0..300 {
+            let r = 0.01 * i as f32;
+            let v = d.rd(r * r);
+            assert!(v < prev && v > 0.0, "r {r}");
+            prev = v;
+        }
+        assert_eq!(d.rd(f32::INFINITY), 0.0);
+        assert_eq!(d.rd(f32::MAX), 0.0);
+    }
+
+    /// The closed form against ∫ 2πr Rd(r) dr by composite Gauss–Legendre over geometric
+    /// intervals (relative 1e-4 required; reached to about 1e-7).
+    #[test]
+    fn total_reflectance_closed_form_matches_numerical_integral() {
+        let rule = GaussLegendre::<32>::new();
+        for &(albedo, eta) in &[
+            (0.3, 1.3),
+            (0.8, 1.3),
+            (0.95, 1.5),
+            (0.99, 1.0),
+            (0.999, 1.5),
+            (0.5, 2.5),
+        ] {
+            let d = UnitDipole::new(albedo, eta);
+            let mut integral = 0.0;
+            let mut a = 0.0;
+            let mut b = 1e-3;
+            // Out to where e^(−σ_tr r) has fallen far below 1e-12.
+            let end = 40.0 / d.sigma_tr().max(1e-3) + 100.0;
+            while a < end {
+                integral += rule.integrate(a, b, |r| 2.0 * core::f64::consts::PI * r * d.rd(r));
+                a = b;
+                b *= 1.5;
+            }
+            let closed = total_reflectance(albedo, eta);
+            assert!(
+                ((integral - closed) / closed).abs() < 1e-5,
+                "α′ {albedo}: {integral} vs {closed}"
+            );
+        }
+    }
+
+    #[test]
+    fn total_reflectance_matches_reference_materials() {
+        // Reference sheet §3: Skin1 0.44 0.23 0.13; Wholemilk 0.91 0.88 0.76 (η 1.3);
+        // Marble 0.83 0.79 0.75 (η 1.5).
+        /// (σ_s′, σ_a, η, expected Rd_total) per material.
+        type Case = ([f32; 3], [f32; 3], f32, [f32; 3]);
+        let cases: [Case; 3] = [
+            (
+                [0.74, 0.88, 1.01],
+                [0.032, 0.17, 0.48],
+                1.3,
+                [0.44, 0.23, 0.13],
+            ),
+            (
+                [2.55, 3.21, 3.77],
+                [0.0011, 0.0024, 0.014],
+                1.3,
+                [0.91, 0.88, 0.76],
+            ),
+            (
+                [2.19, 2.62, 3.00],
+                [0.0021, 0.0041, 0.0071],
+                1.5,
+                [0.83, 0.79, 0.75],
+            ),
+        ];
+        for (ss, sa, eta, want) in cases {
+            for c in 0..3 {
+                let d = Dipole::from_coefficients(sa[c], ss[c], eta).unwrap();
+                assert!(
+                    (d.total_reflectance() - want[c]).abs() < 0.006,
+                    "{} vs {}",
+                    d.total_reflectance(),
+                    want[c]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn albedo_inversion_round_trips() {
+        for eta in [1.0, 1.3, 1.5, 2.5] {
+            for i in 1..1000 {
+                let kd = i as f64 / 1000.0;
+                let albedo = albedo_from_total_reflectance(kd, eta);
+                // Near α′ = 1 the slope of Rd_total(α′) is ~1e4, so 1 ulp of α′ is ~1e-12 of K_d.
+                assert!(
+                    (total_reflectance(albedo, eta) - kd).abs() < 1e-11,
+                    "kd {kd} η {eta}"
+                );
+            }
+        }
+        // Monotone from 0 to 1.
+        assert_eq!(total_reflectance(0.0, 1.3), 0.0);
+        assert!((total_reflectance(1.0, 1.3) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn invalid_coefficients_are_typed_errors() {
+        assert!(matches!(
+            Dipole::from_coefficients(f32::NAN, 1.0, 1.3),
+            Err(ParamError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            Dipole::from_coefficients(1.0, f32::INFINITY, 1.3),
+            Err(ParamError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            Dipole::from_coefficients(-1.0, 1.0, 1.3),
+            Err(ParamError::NotPositive { .. })
+        ));
+        assert!(matches!(
+            Dipole::from_coefficients(1.0, 0.0, 1.3),
+            Err(ParamError::NotPositive { .. })
+        ));
+        assert!(matches!(
+            Dipole::from_coefficients(1.0, 1.0, 0.9),
+            Err(ParamError::EtaBelowOne { .. })
+        ));
+        assert!(matches!(
+            Dipole::from_coefficients(1.0, 1.0, f32::NAN),
+            Err(ParamError::NotFinite { .. })
+        ));
+        // Mean free paths beyond single precision.
+        assert!(matches!(
+            Dipole::from_coefficients(1e30, 1e30, 1.3),
+            Err(ParamError::OutOfRange { .. })
+        ));
+        assert!(matches!(
+            Dipole::from_coefficients(1e-30, 1e-30, 1.3),
+            Err(ParamError::OutOfRange { .. })
+        ));
+    }
+}

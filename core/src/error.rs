@@ -1,0 +1,132 @@
+//! Typed errors. Nothing in the core panics on bad input; it returns one of these.
+
+use core::fmt;
+
+/// An invalid material parameter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamError {
+    /// NaN or ±∞.
+    NotFinite {
+        /// Which parameter.
+        name: &'static str,
+        /// The offending value.
+        value: f32,
+    },
+    /// Zero or negative where a positive value is required.
+    NotPositive {
+        /// Which parameter.
+        name: &'static str,
+        /// The offending value.
+        value: f32,
+    },
+    /// A relative index of refraction below 1 (the dipole's boundary term needs η ≥ 1).
+    EtaBelowOne {
+        /// The offending value.
+        value: f32,
+    },
+    /// A diffuse reflectance K_d outside the open interval (0, 1).
+    ReflectanceOutOfRange {
+        /// The offending value.
+        value: f32,
+    },
+    /// Valid inputs whose derived quantities leave the f32 range (e.g. a mean free path so
+    /// small that Rd(0) overflows).
+    OutOfRange {
+        /// Which parameter.
+        name: &'static str,
+        /// The offending value.
+        value: f32,
+    },
+    /// A preset name that is not in the table.
+    UnknownPreset,
+}
+
+impl fmt::Display for ParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            ParamError::NotFinite { name, value } => {
+                write!(f, "{name} must be a finite number, got {value}")
+            }
+            ParamError::NotPositive { name, value } => {
+                write!(f, "{name} must be positive, got {value}")
+            }
+            ParamError::EtaBelowOne { value } => {
+                write!(
+                    f,
+                    "eta (relative index of refraction) must be at least 1, got {value}"
+                )
+            }
+            ParamError::ReflectanceOutOfRange { value } => {
+                write!(
+                    f,
+                    "kd (diffuse reflectance) must lie strictly between 0 and 1, got {value}"
+                )
+            }
+            ParamError::OutOfRange { name, value } => write!(
+                f,
+                "{name} = {value} is outside the range the dipole can represent in single precision"
+            ),
+            ParamError::UnknownPreset => write!(f, "unknown material preset"),
+        }
+    }
+}
+
+impl core::error::Error for ParamError {}
+
+/// Why an irradiance cache could not be built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BuildError {
+    /// A sample position component is NaN or infinite.
+    NonFinitePosition {
+        /// Index of the sample in the input.
+        index: usize,
+    },
+    /// A sample's area is negative, NaN or infinite.
+    InvalidArea {
+        /// Index of the sample in the input.
+        index: usize,
+        /// The offending value.
+        value: f32,
+    },
+    /// A sample's irradiance has a negative, NaN or infinite channel.
+    InvalidIrradiance {
+        /// Index of the sample in the input.
+        index: usize,
+        /// The offending value.
+        value: f32,
+    },
+    /// More samples than the 32-bit indices can address.
+    TooManySamples {
+        /// How many were given.
+        count: usize,
+    },
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            BuildError::NonFinitePosition { index } => {
+                write!(f, "sample {index}: position is not finite")
+            }
+            BuildError::InvalidArea { index, value } => {
+                write!(
+                    f,
+                    "sample {index}: area must be finite and non-negative, got {value}"
+                )
+            }
+            BuildError::InvalidIrradiance { index, value } => write!(
+                f,
+                "sample {index}: irradiance must be finite and non-negative, got {value}"
+            ),
+            BuildError::TooManySamples { count } => {
+                write!(
+                    f,
+                    "{count} samples exceed the cache's limit of {}",
+                    crate::cache::MAX_SAMPLES
+                )
+            }
+        }
+    }
+}
+
+impl core::error::Error for BuildError {}

@@ -1,0 +1,220 @@
+//! The one place transcendental functions come from.
+//!
+//! Scalar functions call `libm` (never `f32::exp` and friends, which need `std` and whose
+//! results may differ between platforms' C libraries). The 8-lane `exp` used by the SIMD
+//! traversal is a polynomial written here, tested against `libm` below.
+//!
+//! Bit-reproducibility: nothing here uses fused multiply-add or approximate reciprocal
+//! instructions, so results depend only on IEEE-754 single-precision arithmetic.
+
+/// e^x (libm).
+#[inline]
+pub fn exp(x: f32) -> f32 {
+    libm::expf(x)
+}
+
+/// e^x in double precision (libm).
+#[inline]
+pub fn exp64(x: f64) -> f64 {
+    libm::exp(x)
+}
+
+/// √x (libm; exact IEEE rounding).
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
+/// √x in double precision (libm).
+#[inline]
+pub fn sqrt64(x: f64) -> f64 {
+    libm::sqrt(x)
+}
+
+/// Natural logarithm (libm).
+#[inline]
+pub fn ln(x: f32) -> f32 {
+    libm::logf(x)
+}
+
+/// Base-2 logarithm (libm).
+#[inline]
+pub fn log2(x: f32) -> f32 {
+    libm::log2f(x)
+}
+
+/// 2^x (libm).
+#[inline]
+pub fn exp2(x: f32) -> f32 {
+    libm::exp2f(x)
+}
+
+/// Largest integer ≤ x (libm).
+#[inline]
+pub fn floor(x: f32) -> f32 {
+    libm::floorf(x)
+}
+
+/// Cosine in double precision (libm).
+#[inline]
+pub fn cos64(x: f64) -> f64 {
+    libm::cos(x)
+}
+
+/// 2^k for an integer k in the normal range [−126, 127] (exact; built from the exponent bits).
+#[inline]
+pub fn pow2i(k: i32) -> f32 {
+    debug_assert!((-126..=127).contains(&k));
+    f32::from_bits(((k + 127) as u32) << 23)
+}
+
+/// The floor of log₂ x for finite positive normal x, read off the exponent bits.
+#[inline]
+pub fn ilog2(x: f32) -> i32 {
+    ((x.to_bits() >> 23) & 0xff) as i32 - 127
+}
+
+/// Polynomial coefficients of the Cephes single-precision `expf` kernel on
+/// r ∈ [−ln2/2, ln2/2]: e^r ≈ 1 + r + r²·P(r).
+pub(crate) const EXP_POLY: [f32; 6] = [
+    5.000_000_1e-1,
+    1.666_666_5e-1,
+    4.166_579_6e-2,
+    8.333_452e-3,
+    1.398_199_9e-3,
+    1.987_569_1e-4,
+];
+/// ln 2 split in two so that n·LN2_HI is exact for |n| ≤ 2^8 (Cody–Waite reduction).
+pub(crate) const LN2_HI: f32 = 0.693_359_375;
+/// The remainder ln 2 − LN2_HI.
+pub(crate) const LN2_LO: f32 = -2.121_944_4e-4;
+/// Below this, e^x is flushed to zero (e^−87.3 is about the smallest normal f32).
+pub(crate) const EXP_MIN_ARG: f32 = -87.3;
+
+/// e^x for x ≤ 0 by the same reduction and polynomial as the 8-lane version (used to test it
+/// lane-for-lane and by the scalar fallback's tests; the scalar path itself calls [`exp`]).
+pub fn exp_nonpositive_poly(x: f32) -> f32 {
+    if x.is_nan() {
+        return x;
+    }
+    if x < EXP_MIN_ARG {
+        return 0.0;
+    }
+    let x = x.min(0.0);
+    // Round to nearest by adding and subtracting 1.5·2^23 (valid for |x·log2e| < 2^22).
+    let magic = 12_582_912.0_f32;
+    let n = (x * core::f32::consts::LOG2_E + magic) - magic;
+    let r = (x - n * LN2_HI) - n * LN2_LO;
+    let p = EXP_POLY[0]
+        + r * (EXP_POLY[1]
+            + r * (EXP_POLY[2] + r * (EXP_POLY[3] + r * (EXP_POLY[4] + r * EXP_POLY[5]))));
+    let e = 1.0 + r + r * r * p;
+    e * pow2i(n as i32)
+}
+
+#[cfg(feature = "simd")]
+mod wide_exp {
+    use super::*;
+    use wide::{f32x8, i32x8};
+
+    /// e^x on eight lanes for x ≤ 0 (the dipole only ever needs e^(−σ d)): Cody–Waite range
+    /// reduction x = n ln2 + r, the Cephes degree-7 kernel on r, and 2^n assembled from
+    /// exponent bits. Lanes below −87.3 give 0; NaN lanes propagate. Same arithmetic, lane for
+    /// lane, as [`exp_nonpositive_poly`].
+    #[inline(always)]
+    pub fn exp_nonpositive_x8(x: f32x8) -> f32x8 {
+        let zero = f32x8::splat(0.0);
+        let underflow = x.simd_lt(f32x8::splat(EXP_MIN_ARG));
+        let xc = x.max(f32x8::splat(EXP_MIN_ARG)).min(zero);
+        let magic = f32x8::splat(12_582_912.0);
+        let n = (xc * f32x8::splat(core::f32::consts::LOG2_E) + magic) - magic;
+        let r = (xc - n * f32x8::splat(LN2_HI)) - n * f32x8::splat(LN2_LO);
+        let c = |i: usize| f32x8::splat(EXP_POLY[i]);
+        let p = c(0) + r * (c(1) + r * (c(2) + r * (c(3) + r * (c(4) + r * c(5)))));
+        let e = f32x8::splat(1.0) + r + r * r * p;
+        // n is an integer-valued float in [−126, 0]: its exponent bits give 2^n exactly.
+        let bits: i32x8 = (n.round_int() + i32x8::splat(127)) << 23;
+        let scale: f32x8 = wide::bytemuck::cast(bits);
+        let y = e * scale;
+        // Keep NaN lanes NaN (x + 0 propagates them), flush underflow to zero.
+        let nan = x.simd_ne(x);
+        let y = nan.select(x, y);
+        underflow.select(zero, y)
+    }
+}
+
+#[cfg(feature = "simd")]
+pub use wide_exp::exp_nonpositive_x8;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Relative error of the polynomial against libm over the whole range the dipole uses.
+    #[test]
+    fn exp_polynomial_matches_libm() {
+        let mut worst = 0.0_f32;
+        let mut x = -87.0_f32;
+        while x <= 0.0 {
+            let got = exp_nonpositive_poly(x);
+            let want = exp(x);
+            worst = worst.max(((got - want) / want).abs());
+            x += 0.000_37;
+        }
+        assert!(worst < 4e-7, "worst relative error {worst}");
+        assert_eq!(exp_nonpositive_poly(0.0), 1.0);
+        assert_eq!(exp_nonpositive_poly(-200.0), 0.0);
+        assert_eq!(exp_nonpositive_poly(f32::NEG_INFINITY), 0.0);
+        assert!(exp_nonpositive_poly(f32::NAN).is_nan());
+    }
+
+    #[cfg(feature = "simd")]
+    #[test]
+    fn exp_x8_equals_scalar_polynomial_lane_for_lane() {
+        use wide::f32x8;
+        let mut x = -90.0_f32;
+        while x <= 0.0 {
+            let lanes = [
+                x,
+                x * 0.5,
+                x * 0.25,
+                x * 0.125,
+                x * 0.01,
+                x * 1e-4,
+                -0.0,
+                x * 0.9,
+            ];
+            let got = exp_nonpositive_x8(f32x8::from(lanes)).to_array();
+            for (g, l) in got.iter().zip(lanes) {
+                assert_eq!(g.to_bits(), exp_nonpositive_poly(l).to_bits(), "x = {l}");
+            }
+            x += 0.0123;
+        }
+        let special = [
+            f32::NAN,
+            f32::NEG_INFINITY,
+            -87.31,
+            -87.29,
+            0.0,
+            -1e-30,
+            -1.0,
+            -2.0,
+        ];
+        let got = exp_nonpositive_x8(f32x8::from(special)).to_array();
+        assert!(got[0].is_nan());
+        assert_eq!(got[1], 0.0);
+        assert_eq!(got[2], 0.0);
+        assert!(got[3] > 0.0);
+        assert_eq!(got[4], 1.0);
+    }
+
+    #[test]
+    fn pow2_and_ilog2_are_exact() {
+        for k in -126..=127 {
+            let p = pow2i(k);
+            assert_eq!(p, libm::exp2f(k as f32));
+            assert_eq!(ilog2(p), k);
+            assert_eq!(ilog2(p * 1.999), k);
+        }
+    }
+}

@@ -1,0 +1,269 @@
+//! The public query API: which method, its settings, and what a query returns.
+//!
+//! | method | formula (reference sheet) |
+//! |---|---|
+//! | [`Method::Hierarchical`] (JB02, §4) | M_o = Σ_cut Rd·E·A |
+//! | [`Method::LocalGlobal`] (LM07, §5) | M_o = E(x)·K + Σ_cut (1 − w)·Rd·E·A |
+//! | [`Method::EdgeAware`] (N10, §6a) | M_o = E_loc·K + Σ_cut (1 − w)·Rd·E·A, E_loc the kernel-weighted cache irradiance with x inserted at r = 0 |
+//! | [`Method::Exhaustive`] | M_o = Σ_all Rd·E·A |
+
+use core::fmt;
+
+use glam::Vec3;
+
+use crate::cache::traverse::{EDGE_AWARE, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
+use crate::cache::{self, IrradianceCache};
+use crate::kernel::Kernel;
+use crate::lanes::{DefaultLanes, Lanes};
+use crate::profile::Profile;
+use crate::stats::{NoStats, QueryStats, StatsSink};
+
+/// How a query sums the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Method {
+    /// Jensen & Buhler 2002: octree sum with the ΔΩ < ε aggregation rule.
+    Hierarchical,
+    /// Langlands & Mertens 2007: precomputed local term E(x)·K plus the (1 − w) global sum.
+    LocalGlobal,
+    /// Neulander 2010: as LM07, with the local irradiance a kernel-weighted query of the cache
+    /// (soft, faithful shadow edges), computed in the same traversal.
+    #[default]
+    EdgeAware,
+    /// Every sample, no approximation.
+    Exhaustive,
+}
+
+impl Method {
+    /// All methods, in the order above.
+    pub const ALL: [Method; 4] = [
+        Method::Hierarchical,
+        Method::LocalGlobal,
+        Method::EdgeAware,
+        Method::Exhaustive,
+    ];
+
+    /// The kebab-case name used by the scene format and the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Hierarchical => "hierarchical",
+            Method::LocalGlobal => "local-global",
+            Method::EdgeAware => "edge-aware",
+            Method::Exhaustive => "exhaustive",
+        }
+    }
+
+    /// True for the methods with a local term (LM07, N10), which need K and α.
+    pub fn is_split(self) -> bool {
+        matches!(self, Method::LocalGlobal | Method::EdgeAware)
+    }
+}
+
+/// Query settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuerySettings {
+    /// The method.
+    pub method: Method,
+    /// JB02's solid-angle threshold ε: a node is aggregated when A/|x − P|² < ε (0 = never).
+    pub epsilon: f32,
+    /// Relative tolerance for skipping negligible subtrees (0 = never): everything skipped
+    /// adds up to at most `cull_tolerance ×` the global sum, per channel.
+    pub cull_tolerance: f32,
+    /// The smoothing radius α (scene units) of the split methods; α = k·√Ā, see
+    /// [`IrradianceCache::smoothing_radius`].
+    pub smoothing_radius: f32,
+}
+
+impl Default for QuerySettings {
+    /// Edge-aware, ε = 0.05 (pbrt-v2's default), cull tolerance 1e-4, no smoothing radius yet.
+    fn default() -> Self {
+        QuerySettings {
+            method: Method::EdgeAware,
+            epsilon: 0.05,
+            cull_tolerance: 1e-4,
+            smoothing_radius: 0.0,
+        }
+    }
+}
+
+/// The point being shaded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingPoint {
+    /// Position x (scene units).
+    pub position: Vec3,
+    /// Irradiance E(x) at x itself (used by the split methods' local term).
+    pub irradiance: Vec3,
+}
+
+/// A query's result, per RGB channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Exitance {
+    /// Radiant exitance M_o = local + global.
+    pub total: Vec3,
+    /// The local term E_loc·K (zero for the unsplit methods).
+    pub local: Vec3,
+    /// The global (octree or exhaustive) sum.
+    pub global: Vec3,
+    /// The irradiance that drives the local term: E(x) for LM07, E_loc for N10.
+    pub local_irradiance: Vec3,
+}
+
+/// An invalid query input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum QueryError {
+    /// The shading position is NaN or infinite.
+    NonFinitePosition,
+    /// The irradiance at the shading point is negative, NaN or infinite.
+    InvalidIrradiance,
+    /// The local integral K is negative, NaN or infinite.
+    InvalidLocalIntegral,
+    /// A setting is negative, NaN or infinite.
+    InvalidSetting {
+        /// Which setting.
+        name: &'static str,
+        /// Its value.
+        value: f32,
+    },
+}
+
+impl fmt::Display for QueryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            QueryError::NonFinitePosition => write!(f, "shading position is not finite"),
+            QueryError::InvalidIrradiance => write!(
+                f,
+                "irradiance at the shading point must be finite and non-negative"
+            ),
+            QueryError::InvalidLocalIntegral => {
+                write!(f, "local integral K must be finite and non-negative")
+            }
+            QueryError::InvalidSetting { name, value } => {
+                write!(f, "{name} must be finite and non-negative, got {value}")
+            }
+        }
+    }
+}
+
+impl core::error::Error for QueryError {}
+
+fn non_negative(v: Vec3) -> bool {
+    v.is_finite() && v.min_element() >= 0.0
+}
+
+impl QuerySettings {
+    /// Checks every setting is finite and non-negative.
+    pub fn validate(&self) -> Result<(), QueryError> {
+        for (name, value) in [
+            ("epsilon", self.epsilon),
+            ("cull_tolerance", self.cull_tolerance),
+            ("smoothing_radius", self.smoothing_radius),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(QueryError::InvalidSetting { name, value });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl IrradianceCache {
+    /// Radiant exitance at `point` for a material with diffusion profile `profile`.
+    ///
+    /// `local_integral` is K for the same α as `settings.smoothing_radius` (from a
+    /// [`crate::LocalIntegralTable`], e.g. `table.lookup(profile.mean_free_path())`); it is
+    /// ignored by the unsplit methods. Errors only on non-finite or negative inputs.
+    pub fn query(
+        &self,
+        profile: &Profile,
+        point: &ShadingPoint,
+        local_integral: Vec3,
+        settings: &QuerySettings,
+    ) -> Result<Exitance, QueryError> {
+        self.query_with::<DefaultLanes, _>(profile, point, local_integral, settings, &mut NoStats)
+    }
+
+    /// [`IrradianceCache::query`], counting traversal events into `stats`.
+    pub fn query_with_stats(
+        &self,
+        profile: &Profile,
+        point: &ShadingPoint,
+        local_integral: Vec3,
+        settings: &QuerySettings,
+        stats: &mut QueryStats,
+    ) -> Result<Exitance, QueryError> {
+        stats.queries += 1;
+        self.query_with::<DefaultLanes, _>(profile, point, local_integral, settings, stats)
+    }
+
+    /// [`IrradianceCache::query`] with an explicit lane type (SIMD or scalar) and statistics
+    /// sink: for benchmarks and for testing the two lane types against each other.
+    pub fn query_with<L: Lanes, S: StatsSink>(
+        &self,
+        profile: &Profile,
+        point: &ShadingPoint,
+        local_integral: Vec3,
+        settings: &QuerySettings,
+        stats: &mut S,
+    ) -> Result<Exitance, QueryError> {
+        if !point.position.is_finite() {
+            return Err(QueryError::NonFinitePosition);
+        }
+        if !non_negative(point.irradiance) {
+            return Err(QueryError::InvalidIrradiance);
+        }
+        if !non_negative(local_integral) {
+            return Err(QueryError::InvalidLocalIntegral);
+        }
+        settings.validate()?;
+        let params = Params {
+            epsilon: settings.epsilon,
+            cull_tolerance: settings.cull_tolerance,
+            kernel: Kernel::new(settings.smoothing_radius),
+        };
+        let x = point.position;
+        let e = point.irradiance;
+        let result = match settings.method {
+            Method::Exhaustive => {
+                let global = cache::exhaustive::exhaustive_sum_lanes::<L>(self, profile, x);
+                Exitance {
+                    total: global,
+                    global,
+                    ..Exitance::default()
+                }
+            }
+            Method::Hierarchical => {
+                let sums = cache::traverse::<L, S, HIERARCHICAL>(self, profile, x, &params, stats);
+                Exitance {
+                    total: sums.global,
+                    global: sums.global,
+                    ..Exitance::default()
+                }
+            }
+            Method::LocalGlobal => {
+                let sums = cache::traverse::<L, S, LOCAL_GLOBAL>(self, profile, x, &params, stats);
+                split_result(sums, e, local_integral)
+            }
+            Method::EdgeAware => {
+                let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
+                // N10: the shading point joins the kernel-weighted average at r = 0 with weight
+                // Rd(0)·Ā.
+                let centre = profile.rd_zero() * self.mean_area();
+                let den = centre + sums.local_weight;
+                let e_loc = (centre * e + sums.local_flux) / den;
+                // With no weight at all (Ā = 0 and no samples within α) fall back to E(x).
+                let e_loc = Vec3::select(den.cmpgt(Vec3::ZERO) & e_loc.is_finite_mask(), e_loc, e);
+                split_result(sums, e_loc, local_integral)
+            }
+        };
+        Ok(result)
+    }
+}
+
+fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {
+    let local = local_irradiance * k;
+    Exitance {
+        total: local + sums.global,
+        local,
+        global: sums.global,
+        local_irradiance,
+    }
+}

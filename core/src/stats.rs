@@ -1,0 +1,66 @@
+//! Per-query statistics for benchmarks, at no cost to the normal path: the traversal is
+//! generic over a [`StatsSink`], and the normal queries use [`NoStats`], whose empty methods
+//! compile to nothing.
+
+/// Receives traversal events.
+pub trait StatsSink {
+    /// An internal node was opened (its up-to-8 children examined in one batch).
+    #[inline(always)]
+    fn node(&mut self) {}
+    /// `n` node aggregates were used instead of their samples.
+    #[inline(always)]
+    fn aggregates(&mut self, _n: u32) {}
+    /// `n` samples were evaluated individually.
+    #[inline(always)]
+    fn samples(&mut self, _n: u32) {}
+    /// `n` subtrees were skipped as negligible.
+    #[inline(always)]
+    fn culled(&mut self, _n: u32) {}
+}
+
+/// Discards every event.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoStats;
+
+impl StatsSink for NoStats {}
+
+/// Counts traversal events (accumulates over any number of queries).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct QueryStats {
+    /// Queries counted.
+    pub queries: u64,
+    /// Internal nodes opened.
+    pub nodes_opened: u64,
+    /// Node aggregates used (one profile evaluation each).
+    pub aggregates: u64,
+    /// Samples evaluated individually (one profile evaluation each).
+    pub samples: u64,
+    /// Subtrees skipped by the cull tolerance.
+    pub culled: u64,
+}
+
+impl QueryStats {
+    /// Profile evaluations (RGB triples): aggregates plus samples.
+    pub fn profile_evaluations(&self) -> u64 {
+        self.aggregates + self.samples
+    }
+}
+
+impl StatsSink for QueryStats {
+    #[inline(always)]
+    fn node(&mut self) {
+        self.nodes_opened += 1;
+    }
+    #[inline(always)]
+    fn aggregates(&mut self, n: u32) {
+        self.aggregates += n as u64;
+    }
+    #[inline(always)]
+    fn samples(&mut self, n: u32) {
+        self.samples += n as u64;
+    }
+    #[inline(always)]
+    fn culled(&mut self, n: u32) {
+        self.culled += n as u64;
+    }
+}
