@@ -1,4 +1,201 @@
-//! Core micro-benchmarks (divan).
+//! Core micro-benchmarks (divan): `cargo bench -p lucent-core --bench core`.
+//!
+//! The data set is the talk's sphere: radius 1 cm, marble at 10 mm per unit, lit from +z so
+//! there is a terminator, 23k irradiance samples; queries at random points on the surface.
+//! Before the timings, `main` prints the cache's bytes per sample and the traversal statistics
+//! per method (nodes opened and profile evaluations per query), which divan cannot report.
+
+use divan::{Bencher, black_box};
+use lucent_core::cache::exhaustive_sum_lanes;
+use lucent_core::glam::Vec3;
+use lucent_core::lanes::{Lanes, ScalarLanes, SimdLanes};
+use lucent_core::{
+    IrradianceCache, LocalIntegralTable, Method, NoStats, Profile, QuerySettings, QueryStats, Sample, ShadingPoint,
+};
+
+const N: usize = 23_000;
+const QUERIES: usize = 256;
+
+struct Rng(u64);
+impl Rng {
+    fn f32(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn on_sphere(&mut self) -> Vec3 {
+        let z = self.f32() * 2.0 - 1.0;
+        let phi = self.f32() * std::f32::consts::TAU;
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(s * phi.cos(), s * phi.sin(), z)
+    }
+}
+
+fn samples(n: usize) -> Vec<Sample> {
+    let mut rng = Rng(1);
+    let area = 4.0 * std::f32::consts::PI / n as f32;
+    (0..n)
+        .map(|_| {
+            let p = rng.on_sphere();
+            Sample { position: p, area, irradiance: Vec3::splat(p.z.max(0.0)) }
+        })
+        .collect()
+}
+
+struct Setup {
+    cache: IrradianceCache,
+    profile: Profile,
+    k: Vec3,
+    alpha: f32,
+    points: Vec<ShadingPoint>,
+    table: LocalIntegralTable,
+}
+
+fn setup() -> &'static Setup {
+    static SETUP: std::sync::OnceLock<Setup> = std::sync::OnceLock::new();
+    SETUP.get_or_init(|| {
+        let cache = IrradianceCache::build(&samples(N)).unwrap();
+        let profile = Profile::from_preset(lucent_core::presets::find("marble").unwrap(), 10.0).unwrap();
+        let alpha = cache.smoothing_radius(1.5);
+        let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0).unwrap();
+        let k = table.lookup(profile.mean_free_path());
+        let mut rng = Rng(2);
+        let points = (0..QUERIES)
+            .map(|_| {
+                let p = rng.on_sphere();
+                ShadingPoint { position: p, irradiance: Vec3::splat(p.z.max(0.0)) }
+            })
+            .collect();
+        Setup { cache, profile, k, alpha, points, table }
+    })
+}
+
+fn settings(method: Method, alpha: f32) -> QuerySettings {
+    QuerySettings { method, epsilon: 0.05, cull_tolerance: 1e-4, smoothing_radius: alpha }
+}
+
 fn main() {
+    let s = setup();
+    println!(
+        "cache: {} samples, {} nodes, depth {}, {} bytes = {:.1} bytes/sample",
+        s.cache.len(),
+        s.cache.node_count(),
+        s.cache.depth(),
+        s.cache.memory_bytes(),
+        s.cache.memory_bytes() as f64 / s.cache.len() as f64
+    );
+    for method in [Method::Hierarchical, Method::LocalGlobal, Method::EdgeAware] {
+        let mut stats = QueryStats::default();
+        for p in &s.points {
+            s.cache.query_with_stats(&s.profile, p, s.k, &settings(method, s.alpha), &mut stats).unwrap();
+        }
+        let q = stats.queries as f64;
+        println!(
+            "{:>13}: {:.1} nodes opened, {:.1} aggregates, {:.1} samples, {:.1} culled, {:.1} profile evaluations per query",
+            method.name(),
+            stats.nodes_opened as f64 / q,
+            stats.aggregates as f64 / q,
+            stats.samples as f64 / q,
+            stats.culled as f64 / q,
+            stats.profile_evaluations() as f64 / q
+        );
+    }
     divan::main();
+}
+
+/// One RGB profile evaluation per item (scalar `Profile::rd`).
+#[divan::bench(counter = divan::counter::ItemsCount::new(1024usize))]
+fn rd_scalar(b: Bencher) {
+    let p = setup().profile;
+    let r2: Vec<f32> = (0..1024).map(|i| i as f32 * 1e-3).collect();
+    b.bench(|| {
+        let mut acc = Vec3::ZERO;
+        for &x in &r2 {
+            acc += p.rd(black_box(x));
+        }
+        acc
+    });
+}
+
+/// RGB profile evaluations in 8-lane batches, per lane type.
+#[divan::bench(types = [ScalarLanes, SimdLanes], counter = divan::counter::ItemsCount::new(1024usize))]
+fn rd_lanes<L: Lanes>(b: Bencher) {
+    let p = setup().profile;
+    let r2: Vec<f32> = (0..1024 + 8).map(|i| i as f32 * 1e-3).collect();
+    b.bench(|| {
+        let mut acc = L::splat(0.0);
+        for i in (0..1024).step_by(8) {
+            let rd = p.rd_lanes(L::load(&r2[i..]));
+            acc = acc + rd[0] + rd[1] + rd[2];
+        }
+        acc.reduce_add()
+    });
+}
+
+/// Cache construction, samples per second.
+#[divan::bench(args = [2_000, 23_000, 100_000])]
+fn build(b: Bencher, n: usize) {
+    let input = samples(n);
+    b.counter(divan::counter::ItemsCount::new(n)).bench(|| IrradianceCache::build(black_box(&input)).unwrap());
+}
+
+fn run_queries<L: Lanes>(b: Bencher, method: Method) {
+    let s = setup();
+    let settings = settings(method, s.alpha);
+    b.counter(divan::counter::ItemsCount::new(QUERIES)).bench(|| {
+        let mut acc = Vec3::ZERO;
+        for p in &s.points {
+            acc += s.cache.query_with::<L, _>(&s.profile, black_box(p), s.k, &settings, &mut NoStats).unwrap().total;
+        }
+        acc
+    });
+}
+
+/// Queries per second per method at 23k samples (ε 0.05, cull tolerance 1e-4, k 1.5).
+#[divan::bench(types = [ScalarLanes, SimdLanes])]
+fn query_hierarchical<L: Lanes>(b: Bencher) {
+    run_queries::<L>(b, Method::Hierarchical);
+}
+
+/// See [`query_hierarchical`].
+#[divan::bench(types = [ScalarLanes, SimdLanes])]
+fn query_local_global<L: Lanes>(b: Bencher) {
+    run_queries::<L>(b, Method::LocalGlobal);
+}
+
+/// See [`query_hierarchical`].
+#[divan::bench(types = [ScalarLanes, SimdLanes])]
+fn query_edge_aware<L: Lanes>(b: Bencher) {
+    run_queries::<L>(b, Method::EdgeAware);
+}
+
+/// The exhaustive sum over all 23k samples (per query).
+#[divan::bench(types = [ScalarLanes, SimdLanes], sample_count = 20)]
+fn query_exhaustive<L: Lanes>(b: Bencher) {
+    let s = setup();
+    b.counter(divan::counter::ItemsCount::new(16usize)).bench(|| {
+        let mut acc = Vec3::ZERO;
+        for p in &s.points[..16] {
+            acc += exhaustive_sum_lanes::<L>(&s.cache, &s.profile, black_box(p.position));
+        }
+        acc
+    });
+}
+
+/// Local-integral table lookups on cached nodes (varying ℓ over two decades).
+#[divan::bench(counter = divan::counter::ItemsCount::new(1024usize))]
+fn table_lookup(b: Bencher) {
+    let s = setup();
+    let base = s.profile.mean_free_path();
+    let ells: Vec<Vec3> = (0..1024).map(|i| base * (0.1 + 9.9 * i as f32 / 1024.0)).collect();
+    s.table.prefill(base.min_element() * 0.1, base.max_element() * 10.0);
+    b.bench(|| {
+        let mut acc = Vec3::ZERO;
+        for &l in &ells {
+            acc += s.table.lookup(black_box(l));
+        }
+        acc
+    });
 }
