@@ -10,7 +10,8 @@ use lucent_core::cache::exhaustive_sum_lanes;
 use lucent_core::glam::Vec3;
 use lucent_core::lanes::{Lanes, ScalarLanes, SimdLanes};
 use lucent_core::{
-    IrradianceCache, LocalIntegralTable, Method, NoStats, Profile, QuerySettings, QueryStats, Sample, ShadingPoint,
+    IrradianceCache, LocalIntegralTable, Method, NoStats, Profile, QuerySettings, QueryStats,
+    Sample, ShadingPoint,
 };
 
 const N: usize = 23_000;
@@ -39,7 +40,11 @@ fn samples(n: usize) -> Vec<Sample> {
     (0..n)
         .map(|_| {
             let p = rng.on_sphere();
-            Sample { position: p, area, irradiance: Vec3::splat(p.z.max(0.0)) }
+            Sample {
+                position: p,
+                area,
+                irradiance: Vec3::splat(p.z.max(0.0)),
+            }
         })
         .collect()
 }
@@ -57,7 +62,8 @@ fn setup() -> &'static Setup {
     static SETUP: std::sync::OnceLock<Setup> = std::sync::OnceLock::new();
     SETUP.get_or_init(|| {
         let cache = IrradianceCache::build(&samples(N)).unwrap();
-        let profile = Profile::from_preset(lucent_core::presets::find("marble").unwrap(), 10.0).unwrap();
+        let profile =
+            Profile::from_preset(lucent_core::presets::find("marble").unwrap(), 10.0).unwrap();
         let alpha = cache.smoothing_radius(1.5);
         let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0).unwrap();
         let k = table.lookup(profile.mean_free_path());
@@ -65,15 +71,30 @@ fn setup() -> &'static Setup {
         let points = (0..QUERIES)
             .map(|_| {
                 let p = rng.on_sphere();
-                ShadingPoint { position: p, irradiance: Vec3::splat(p.z.max(0.0)) }
+                ShadingPoint {
+                    position: p,
+                    irradiance: Vec3::splat(p.z.max(0.0)),
+                }
             })
             .collect();
-        Setup { cache, profile, k, alpha, points, table }
+        Setup {
+            cache,
+            profile,
+            k,
+            alpha,
+            points,
+            table,
+        }
     })
 }
 
 fn settings(method: Method, alpha: f32) -> QuerySettings {
-    QuerySettings { method, epsilon: 0.05, cull_tolerance: 1e-4, smoothing_radius: alpha }
+    QuerySettings {
+        method,
+        epsilon: 0.05,
+        cull_tolerance: 1e-4,
+        smoothing_radius: alpha,
+    }
 }
 
 fn main() {
@@ -89,7 +110,9 @@ fn main() {
     for method in [Method::Hierarchical, Method::LocalGlobal, Method::EdgeAware] {
         let mut stats = QueryStats::default();
         for p in &s.points {
-            s.cache.query_with_stats(&s.profile, p, s.k, &settings(method, s.alpha), &mut stats).unwrap();
+            s.cache
+                .query_with_stats(&s.profile, p, s.k, &settings(method, s.alpha), &mut stats)
+                .unwrap();
         }
         let q = stats.queries as f64;
         println!(
@@ -138,19 +161,25 @@ fn rd_lanes<L: Lanes>(b: Bencher) {
 #[divan::bench(args = [2_000, 23_000, 100_000])]
 fn build(b: Bencher, n: usize) {
     let input = samples(n);
-    b.counter(divan::counter::ItemsCount::new(n)).bench(|| IrradianceCache::build(black_box(&input)).unwrap());
+    b.counter(divan::counter::ItemsCount::new(n))
+        .bench(|| IrradianceCache::build(black_box(&input)).unwrap());
 }
 
 fn run_queries<L: Lanes>(b: Bencher, method: Method) {
     let s = setup();
     let settings = settings(method, s.alpha);
-    b.counter(divan::counter::ItemsCount::new(QUERIES)).bench(|| {
-        let mut acc = Vec3::ZERO;
-        for p in &s.points {
-            acc += s.cache.query_with::<L, _>(&s.profile, black_box(p), s.k, &settings, &mut NoStats).unwrap().total;
-        }
-        acc
-    });
+    b.counter(divan::counter::ItemsCount::new(QUERIES))
+        .bench(|| {
+            let mut acc = Vec3::ZERO;
+            for p in &s.points {
+                acc += s
+                    .cache
+                    .query_with::<L, _>(&s.profile, black_box(p), s.k, &settings, &mut NoStats)
+                    .unwrap()
+                    .total;
+            }
+            acc
+        });
 }
 
 /// Queries per second per method at 23k samples (ε 0.05, cull tolerance 1e-4, k 1.5).
@@ -175,13 +204,14 @@ fn query_edge_aware<L: Lanes>(b: Bencher) {
 #[divan::bench(types = [ScalarLanes, SimdLanes], sample_count = 20)]
 fn query_exhaustive<L: Lanes>(b: Bencher) {
     let s = setup();
-    b.counter(divan::counter::ItemsCount::new(16usize)).bench(|| {
-        let mut acc = Vec3::ZERO;
-        for p in &s.points[..16] {
-            acc += exhaustive_sum_lanes::<L>(&s.cache, &s.profile, black_box(p.position));
-        }
-        acc
-    });
+    b.counter(divan::counter::ItemsCount::new(16usize))
+        .bench(|| {
+            let mut acc = Vec3::ZERO;
+            for p in &s.points[..16] {
+                acc += exhaustive_sum_lanes::<L>(&s.cache, &s.profile, black_box(p.position));
+            }
+            acc
+        });
 }
 
 /// Local-integral table lookups on cached nodes (varying ℓ over two decades).
@@ -189,8 +219,11 @@ fn query_exhaustive<L: Lanes>(b: Bencher) {
 fn table_lookup(b: Bencher) {
     let s = setup();
     let base = s.profile.mean_free_path();
-    let ells: Vec<Vec3> = (0..1024).map(|i| base * (0.1 + 9.9 * i as f32 / 1024.0)).collect();
-    s.table.prefill(base.min_element() * 0.1, base.max_element() * 10.0);
+    let ells: Vec<Vec3> = (0..1024)
+        .map(|i| base * (0.1 + 9.9 * i as f32 / 1024.0))
+        .collect();
+    s.table
+        .prefill(base.min_element() * 0.1, base.max_element() * 10.0);
     b.bench(|| {
         let mut acc = Vec3::ZERO;
         for &l in &ells {

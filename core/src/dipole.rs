@@ -60,6 +60,48 @@ pub fn albedo_from_total_reflectance(kd: f64, eta: f64) -> f64 {
     1.0 - s * s / 3.0
 }
 
+/// A precomputed inverse of Rd_total for one η: K_d → α′ by table lookup, for texture-mapped
+/// reflectance (one inversion per shading point; bisection would cost ~60 exponentials).
+///
+/// Tabulates s = √(3(1 − α′)) on a uniform grid of K_d ∈ [0, 1] (s is smooth in K_d at both
+/// ends, unlike α′) and interpolates linearly: α′ = 1 − s²/3. Accurate to about 1e-6 in K_d
+/// (test `albedo_inverter_matches_bisection`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AlbedoInverter {
+    eta: f32,
+    s: alloc::vec::Vec<f32>,
+}
+
+impl AlbedoInverter {
+    const SIZE: usize = 4096;
+
+    /// Builds the table for relative index `eta` (≥ 1; callers validate).
+    pub fn new(eta: f32) -> Self {
+        let s = (0..=Self::SIZE)
+            .map(|i| {
+                let kd = (i as f64 / Self::SIZE as f64).clamp(1e-9, 1.0 - 1e-12);
+                math::sqrt64(3.0 * (1.0 - albedo_from_total_reflectance(kd, eta as f64))) as f32
+            })
+            .collect();
+        AlbedoInverter { eta, s }
+    }
+
+    /// The η the table was built for.
+    pub fn eta(&self) -> f32 {
+        self.eta
+    }
+
+    /// α′ with Rd_total(α′) = `kd` (clamped into [0, 1]).
+    #[inline]
+    pub fn albedo(&self, kd: f32) -> f64 {
+        let x = kd.clamp(0.0, 1.0) * Self::SIZE as f32;
+        let i = (x as usize).min(Self::SIZE - 1);
+        let t = x - i as f32;
+        let s = (self.s[i] + (self.s[i + 1] - self.s[i]) * t) as f64;
+        1.0 - s * s / 3.0
+    }
+}
+
 /// One channel of the dipole, with everything precomputed for evaluation from r².
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dipole {
@@ -426,6 +468,20 @@ mod tests {
         // Monotone from 0 to 1.
         assert_eq!(total_reflectance(0.0, 1.3), 0.0);
         assert!((total_reflectance(1.0, 1.3) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn albedo_inverter_matches_bisection() {
+        for eta in [1.0_f32, 1.3, 1.5, 2.5] {
+            let inv = AlbedoInverter::new(eta);
+            let mut worst = 0.0_f64;
+            for i in 1..10_000 {
+                let kd = i as f64 / 10_000.0;
+                let got = total_reflectance(inv.albedo(kd as f32), eta as f64);
+                worst = worst.max((got - kd).abs());
+            }
+            assert!(worst < 2e-6, "η {eta}: worst K_d error {worst}");
+        }
     }
 
     #[test]

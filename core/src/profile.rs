@@ -121,6 +121,26 @@ impl Profile {
         ))
     }
 
+    /// From the reduced albedo α′ (in (0, 1]) and reduced extinction σ_t′ = 1/ℓ_u (per scene
+    /// unit) per channel, and η: the form texture-mapped parameters arrive in (see
+    /// [`crate::dipole::AlbedoInverter`]).
+    pub fn from_albedo_and_extinction(
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+        eta: f32,
+    ) -> Result<Self, ParamError> {
+        let mut ch = [None; 3];
+        for (c, slot) in ch.iter_mut().enumerate() {
+            *slot = Some(Dipole::from_albedo_and_extinction(
+                albedo[c], sigma_t[c], eta,
+            )?);
+        }
+        Ok(Self::from_channels(
+            ch.map(|d| d.expect("filled above")),
+            eta,
+        ))
+    }
+
     /// From a measured material of J01 (see [`crate::presets`]) and the number of millimetres
     /// per scene unit (the table is per mm; a scene modelled in centimetres passes 10).
     pub fn from_preset(preset: &Preset, mm_per_unit: f32) -> Result<Self, ParamError> {
@@ -140,6 +160,24 @@ impl Profile {
         for (c, d) in ch.iter_mut().enumerate() {
             check_distance("mean_free_path", ell_u[c])?;
             *d = Dipole::from_albedo_and_extinction(d.albedo(), 1.0 / ell_u[c] as f64, self.eta)?;
+        }
+        Ok(Profile {
+            channels: ch,
+            ..*self
+        })
+    }
+
+    /// The same η with new α′ and σ_t′ per channel: a texture-mapped material at one shading
+    /// point. Cheaper than [`Profile::from_albedo_and_extinction`] (keeps the Fresnel
+    /// normalisation computed for this η).
+    pub fn with_albedo_and_extinction(
+        &self,
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+    ) -> Result<Self, ParamError> {
+        let mut ch = self.channels;
+        for (c, d) in ch.iter_mut().enumerate() {
+            *d = Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], self.eta)?;
         }
         Ok(Profile {
             channels: ch,

@@ -18,6 +18,7 @@ pub mod camera;
 pub mod cli;
 pub mod geometry;
 pub mod lights;
+pub mod material;
 pub mod output;
 pub mod raster;
 pub mod render;

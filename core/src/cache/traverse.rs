@@ -5,19 +5,28 @@
 //! examines all its children at once in 8 lanes:
 //!
 //! 1. distance² from x to each child's bounds (`dmin2`, 0 inside) and to its centroid;
-//! 2. **aggregate** (JB02): x outside the bounds, the bounds clear of the α-ball (split modes,
-//!    LM07's refinement rule), and ΔΩ = A/|x − P|² < ε → add Rd(|x − P|)·flux;
-//! 3. **cull**: of the rest, a child is skipped (never one touching the α-ball) when, in every
+//! 2. **prune** children without flux (unlit, shadowed) — they add nothing — unless N10 needs
+//!    their area for the local weight (children touching the α-ball);
+//! 3. **aggregate** (JB02): x outside the bounds, the bounds clear of the α-ball (split modes,
+//!    LM07's refinement rule), and ΔΩ = A/|x − P|² < ε → one term Rd(|x − P|)·flux;
+//! 4. **cull**: of the rest, a child is skipped (never one touching the α-ball) when, in every
 //!    channel, its contribution bound Rd(dmin)·flux (Rd is decreasing) is at most
 //!    `tolerance × (sum so far) × A_child / A_total`. Culled subtrees are disjoint and the
 //!    running sum never exceeds the result, so all culled work together is at most
-//!    `tolerance × result`. (A first version compared each subtree with `tolerance × sum`
-//!    alone; thousands of culled subtrees then added up to 3% error at ε = 0.001.)
-//! 4. open the others: leaves are summed at once (one 8-lane batch), internal children are
-//!    pushed, the nearest last so that it is popped first and the running sum grows fast.
+//!    `tolerance × result`. The bound is only evaluated beyond two diffusion lengths, where a
+//!    cull can succeed. (A first version compared each subtree with `tolerance × sum` alone;
+//!    thousands of culled subtrees then added up to 3% error at ε = 0.001.)
+//! 5. open the others: a leaf's samples become terms at once, internal children are pushed,
+//!    the nearest last so that it is popped first and the running sum grows fast.
 //!
-//! In the split modes a leaf touching the α-ball evaluates the kernel w per sample: the global
-//! sum gets (1 − w)·Rd·flux and, for N10, the local irradiance gets w·Rd·flux over w·Rd·A.
+//! Terms (r², flux, area) from steps 3 and 5 are compacted into a small buffer and the profile
+//! is evaluated on full 8-lane batches only: a first version evaluated Rd on every lane of
+//! every examined batch and wasted about three quarters of the lanes (most children are
+//! neither all aggregated nor all opened, most leaves are not full).
+//!
+//! In the split modes every term also gets the kernel weight w(r) (zero beyond α, which covers
+//! every aggregate and every sample of a leaf clear of the α-ball): the global sum gets
+//! (1 − w)·Rd·flux and, for N10, the local irradiance gets w·Rd·flux over w·Rd·A.
 //! Modes are const generics, so each is compiled without the others' work.
 
 use glam::Vec3;
@@ -37,6 +46,8 @@ pub(crate) const EDGE_AWARE: u8 = 2;
 
 /// Room for the deepest tree: each level leaves at most 7 siblings on the stack.
 const STACK_SIZE: usize = (LANES - 1) * MAX_DEPTH + LANES;
+/// Term buffer: up to 8 pending terms plus one batch being appended.
+const BUFFER: usize = 2 * LANES;
 
 /// Traversal parameters (validated by the caller).
 #[derive(Clone, Copy, Debug)]
@@ -57,11 +68,20 @@ pub(crate) struct Sums {
     pub local_weight: Vec3,
 }
 
+/// Pending terms in structure-of-arrays form.
+struct Terms {
+    r2: [f32; BUFFER],
+    flux: [[f32; BUFFER]; 3],
+    area: [f32; BUFFER],
+    len: usize,
+}
+
 struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     cache: &'a IrradianceCache,
     profile: &'a Profile,
     kernel: Kernel,
     x: [L; 3],
+    terms: Terms,
     global: [L; 3],
     local_flux: [L; 3],
     local_weight: [L; 3],
@@ -69,26 +89,19 @@ struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
 }
 
 impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
-    /// Sums one leaf's samples. `near`: the leaf's bounds meet the α-ball.
+    /// Evaluates the first `n ≤ 8` pending terms (the rest of the batch is masked off).
     #[inline(always)]
-    fn leaf(&mut self, node: usize, near: bool) {
-        let nodes = &self.cache.nodes;
-        let s = &self.cache.samples;
-        let first = nodes.first[node] as usize;
-        let count = nodes.info[node] & COUNT_MASK;
-        let valid = Mask::first(count);
-        self.stats.samples(count);
-        let px = L::load(&s.pos_x[first..]) - self.x[0];
-        let py = L::load(&s.pos_y[first..]) - self.x[1];
-        let pz = L::load(&s.pos_z[first..]) - self.x[2];
-        let r2 = px * px + py * py + pz * pz;
+    fn evaluate(&mut self, n: usize) {
+        let t = &self.terms;
+        let valid = Mask::first(n as u32);
+        let r2 = L::load(&t.r2);
         let rd = self.profile.rd_lanes(r2);
         let flux = [
-            L::load(&s.flux_r[first..]).keep(valid),
-            L::load(&s.flux_g[first..]).keep(valid),
-            L::load(&s.flux_b[first..]).keep(valid),
+            L::load(&t.flux[0]).keep(valid),
+            L::load(&t.flux[1]).keep(valid),
+            L::load(&t.flux[2]).keep(valid),
         ];
-        if MODE == HIERARCHICAL || !near {
+        if MODE == HIERARCHICAL {
             for c in 0..3 {
                 self.global[c] = self.global[c] + rd[c] * flux[c];
             }
@@ -97,18 +110,83 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         let w = self.kernel.weight_lanes(r2);
         let one_minus_w = L::splat(1.0) - w;
         let area = if MODE == EDGE_AWARE {
-            L::load(&s.area[first..]).keep(valid)
+            L::load(&t.area).keep(valid)
         } else {
             L::splat(0.0)
         };
         for c in 0..3 {
-            let t = rd[c] * flux[c];
-            self.global[c] = self.global[c] + t * one_minus_w;
+            let term = rd[c] * flux[c];
+            self.global[c] = self.global[c] + term * one_minus_w;
             if MODE == EDGE_AWARE {
-                self.local_flux[c] = self.local_flux[c] + t * w;
+                self.local_flux[c] = self.local_flux[c] + term * w;
                 self.local_weight[c] = self.local_weight[c] + rd[c] * area * w;
             }
         }
+    }
+
+    /// Appends the lanes of `keep` as terms; evaluates a full batch when one is ready.
+    #[inline(always)]
+    fn push(&mut self, keep: Mask, r2: L, flux: &[L; 3], area: L) {
+        if !keep.any() {
+            return;
+        }
+        let r2 = r2.to_array();
+        let flux = [flux[0].to_array(), flux[1].to_array(), flux[2].to_array()];
+        let area = area.to_array();
+        let t = &mut self.terms;
+        let mut bits = keep.0;
+        while bits != 0 {
+            let lane = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let i = t.len;
+            t.r2[i] = r2[lane];
+            t.flux[0][i] = flux[0][lane];
+            t.flux[1][i] = flux[1][lane];
+            t.flux[2][i] = flux[2][lane];
+            t.area[i] = area[lane];
+            t.len += 1;
+        }
+        if t.len >= LANES {
+            self.evaluate(LANES);
+            let t = &mut self.terms;
+            let rest = t.len - LANES;
+            t.r2.copy_within(LANES..t.len, 0);
+            for f in &mut t.flux {
+                f.copy_within(LANES..LANES + rest, 0);
+            }
+            t.area.copy_within(LANES..LANES + rest, 0);
+            t.len = rest;
+        }
+    }
+
+    /// Turns one leaf's samples into terms. `near`: the leaf's bounds meet the α-ball.
+    #[inline(always)]
+    fn leaf(&mut self, node: usize, near: bool) {
+        let nodes = &self.cache.nodes;
+        let s = &self.cache.samples;
+        let first = nodes.first[node] as usize;
+        let count = nodes.info[node] & COUNT_MASK;
+        self.stats.samples(count);
+        let px = L::load(&s.pos_x[first..]) - self.x[0];
+        let py = L::load(&s.pos_y[first..]) - self.x[1];
+        let pz = L::load(&s.pos_z[first..]) - self.x[2];
+        let r2 = px * px + py * py + pz * pz;
+        let flux = [
+            L::load(&s.flux_r[first..]),
+            L::load(&s.flux_g[first..]),
+            L::load(&s.flux_b[first..]),
+        ];
+        let mut keep = Mask::first(count);
+        if !(MODE == EDGE_AWARE && near) {
+            // Samples without flux add nothing (N10 near x still needs their area).
+            keep = keep & L::splat(0.0).lt(flux[0] + flux[1] + flux[2]);
+        }
+        let area = if MODE == EDGE_AWARE {
+            L::load(&s.area[first..])
+        } else {
+            L::splat(0.0)
+        };
+        self.push(keep, r2, &flux, area);
     }
 
     fn run(&mut self, params: &Params) {
@@ -118,6 +196,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         }
         if nodes.info[0] & LEAF_BIT != 0 {
             self.leaf(0, true);
+            self.flush();
             return;
         }
         let zero = L::splat(0.0);
@@ -129,6 +208,15 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         });
         let tolerance = params.cull_tolerance;
         let total_area = nodes.area[0].max(f32::MIN_POSITIVE);
+        // Culling is only attempted beyond two diffusion lengths of the slowest channel.
+        let sigma_tr_min = self
+            .profile
+            .channels()
+            .iter()
+            .map(|d| d.sigma_tr())
+            .fold(f32::INFINITY, f32::min);
+        let cull_from = 2.0 / sigma_tr_min;
+        let cull_from2 = L::splat(cull_from * cull_from);
         let [xx, xy, xz] = self.x;
 
         let mut stack = [0u32; STACK_SIZE];
@@ -151,41 +239,46 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                 .max(xz - load(&nodes.max_z))
                 .max(zero);
             let dmin2 = dx * dx + dy * dy + dz * dz;
-            let cx = load(&nodes.centroid_x) - xx;
-            let cy = load(&nodes.centroid_y) - xy;
-            let cz = load(&nodes.centroid_z) - xz;
-            let dist2 = cx * cx + cy * cy + cz * cz;
             let flux = [
                 load(&nodes.flux_r),
                 load(&nodes.flux_g),
                 load(&nodes.flux_b),
             ];
-
             let near = dmin2.lt(alpha2); // bounds meet the α-ball (never in JB02 mode)
-            let outside = zero.lt(dmin2);
-            let small = load(&nodes.area).lt(eps * dist2);
-            let aggregate = valid & outside & !near & small;
-            if aggregate.any() {
-                let rd = self.profile.rd_lanes(dist2);
-                for c in 0..3 {
-                    self.global[c] = self.global[c] + (rd[c] * flux[c]).keep(aggregate);
-                }
-                self.stats.aggregates(aggregate.0.count_ones());
+            let lit = zero.lt(flux[0] + flux[1] + flux[2]);
+            let live = if MODE == EDGE_AWARE {
+                valid & (lit | near)
+            } else {
+                valid & lit
+            };
+            if !live.any() {
+                continue;
             }
 
-            let mut open = valid & !aggregate;
+            let cx = load(&nodes.centroid_x) - xx;
+            let cy = load(&nodes.centroid_y) - xy;
+            let cz = load(&nodes.centroid_z) - xz;
+            let dist2 = cx * cx + cy * cy + cz * cz;
+            let area = load(&nodes.area);
+            let outside = zero.lt(dmin2);
+            let small = area.lt(eps * dist2);
+            let aggregate = live & outside & !near & small;
+            if aggregate.any() {
+                self.stats.aggregates(aggregate.0.count_ones());
+                self.push(aggregate, dist2, &flux, area);
+            }
+
+            let mut open = live & !aggregate;
             if !open.any() {
                 continue;
             }
-            let cullable = open & !near;
+            let cullable = open & !near & cull_from2.lt(dmin2);
             if tolerance > 0.0 && cullable.any() {
                 let running = self.global.map(|g| g.reduce_add());
                 if running.iter().any(|&r| r > 0.0) {
                     // Area-budgeted bound: Rd(dmin)·flux ≤ tol · running · A_node / A_total.
-                    // Culled subtrees are disjoint and running ≤ the final sum, so everything
-                    // culled adds up to at most tol × the result, per channel.
                     let bound = self.profile.rd_lanes(dmin2);
-                    let budget = load(&nodes.area) * L::splat(tolerance / total_area);
+                    let budget = area * L::splat(tolerance / total_area);
                     let mut negligible = Mask(0xff);
                     for c in 0..3 {
                         // Not (budget · running < bound · flux).
@@ -219,6 +312,15 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                 stack.swap(nearest.1, sp - 1);
             }
         }
+        self.flush();
+    }
+
+    /// Evaluates the last, partial batch.
+    fn flush(&mut self) {
+        if self.terms.len > 0 {
+            self.evaluate(self.terms.len);
+            self.terms.len = 0;
+        }
     }
 }
 
@@ -237,6 +339,12 @@ pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
         profile,
         kernel: params.kernel,
         x: [L::splat(x.x), L::splat(x.y), L::splat(x.z)],
+        terms: Terms {
+            r2: [0.0; BUFFER],
+            flux: [[0.0; BUFFER]; 3],
+            area: [0.0; BUFFER],
+            len: 0,
+        },
         global: zero,
         local_flux: zero,
         local_weight: zero,

@@ -1,0 +1,453 @@
+//! Scene materials resolved for shading: the diffusion profile at a surface point (constant,
+//! or from texture-mapped K_d and mean free path) and the local integral K of the split
+//! methods at that point.
+//!
+//! Texture-mapped ℓ with constant K_d is N10's case: α′ is fixed, so one
+//! [`LocalIntegralTable`] (cached at powers of two of ℓ) serves every point. A texture-mapped
+//! K_d also varies α′; K then comes from tables at `KD_LEVELS + 1` evenly spaced K_d values,
+//! built on first use and interpolated linearly in K_d per channel.
+
+use std::sync::{Arc, OnceLock};
+
+use glam::{Vec2, Vec3};
+use lucent_core::dipole::AlbedoInverter;
+use lucent_core::{Distance as CoreDistance, LocalIntegralTable, ParamError, Profile, presets};
+
+use crate::scene::{ColorParam, Distance, Material, Medium, ScalarParam, Specular};
+use crate::texture::Texture;
+
+/// K_d levels of the tables behind a texture-mapped K_d.
+const KD_LEVELS: usize = 64;
+
+/// A material ready for shading.
+#[derive(Debug)]
+pub enum Shader {
+    /// Subsurface scattering through the core.
+    Translucent(Box<TranslucentShader>),
+    /// Opaque Lambert.
+    Lambert {
+        /// Diffuse reflectance.
+        albedo: Vec3,
+    },
+}
+
+impl Shader {
+    /// Resolves a scene material (validating its parameters).
+    pub fn new(material: &Material) -> Result<Shader, String> {
+        match material {
+            Material::Lambert { albedo, .. } => Ok(Shader::Lambert { albedo: *albedo }),
+            Material::Translucent(t) => {
+                let err = |e: ParamError| format!("material '{}': {e}", t.name);
+                let params = match &t.medium {
+                    Medium::Preset { name, mm_per_unit } => {
+                        let preset = presets::find(name).ok_or_else(|| {
+                            format!("material '{}': unknown preset '{name}'", t.name)
+                        })?;
+                        Params::Fixed(Profile::from_preset(preset, *mm_per_unit).map_err(err)?)
+                    }
+                    Medium::Coefficients {
+                        sigma_a,
+                        sigma_s_prime,
+                        eta,
+                    } => Params::Fixed(
+                        Profile::from_coefficients(*sigma_a, *sigma_s_prime, *eta).map_err(err)?,
+                    ),
+                    Medium::Reflectance { kd, distance, eta } => {
+                        reflectance_params(kd, distance, *eta).map_err(err)?
+                    }
+                };
+                Ok(Shader::Translucent(Box::new(TranslucentShader {
+                    name: t.name.clone(),
+                    params,
+                    specular: t.specular,
+                })))
+            }
+        }
+    }
+}
+
+/// How the translucent parameters vary over the surface.
+#[derive(Debug)]
+enum Params {
+    /// The same profile everywhere.
+    Fixed(Profile),
+    /// K_d and a distance, either of which may be a texture.
+    Reflectance {
+        base: Profile,
+        kd: KdSource,
+        distance: Distance,
+    },
+}
+
+#[derive(Debug)]
+enum KdSource {
+    Constant([f64; 3]),
+    Texture(Arc<Texture>, AlbedoInverter),
+}
+
+/// Validates every constant and both ends of every texture range by building profiles there.
+fn reflectance_params(
+    kd: &ColorParam,
+    distance: &Distance,
+    eta: f32,
+) -> Result<Params, ParamError> {
+    let representative_kd = match kd {
+        ColorParam::Constant(v) => *v,
+        ColorParam::Texture(_) => Vec3::splat(0.5),
+    };
+    let ends = |p: &ScalarParam| match p {
+        ScalarParam::Constant(v) => (*v, *v),
+        ScalarParam::Texture { min, max, .. } => (Vec3::splat(*min), Vec3::splat(*max)),
+    };
+    let (lo, hi, make): (Vec3, Vec3, fn(Vec3) -> CoreDistance) = match distance {
+        Distance::MeanFreePath(p) => {
+            let (lo, hi) = ends(p);
+            (lo, hi, CoreDistance::MeanFreePath)
+        }
+        Distance::DiffuseMeanFreePath(p) => {
+            let (lo, hi) = ends(p);
+            (lo, hi, CoreDistance::DiffuseMeanFreePath)
+        }
+    };
+    let base = Profile::from_reflectance(representative_kd, make(lo), eta)?;
+    Profile::from_reflectance(representative_kd, make(hi), eta)?;
+    let kd = match kd {
+        ColorParam::Constant(_) => KdSource::Constant(base.channels().map(|d| d.albedo())),
+        ColorParam::Texture(t) => {
+            // Both ends of the reflectance range must make valid profiles too.
+            for v in [0.001, 0.999] {
+                Profile::from_reflectance(Vec3::splat(v), make(lo), eta)?;
+            }
+            KdSource::Texture(t.clone(), AlbedoInverter::new(eta))
+        }
+    };
+    Ok(Params::Reflectance {
+        base,
+        kd,
+        distance: distance.clone(),
+    })
+}
+
+/// A translucent material.
+#[derive(Debug)]
+pub struct TranslucentShader {
+    /// Name from the scene file.
+    pub name: String,
+    params: Params,
+    /// The optional highlight.
+    pub specular: Option<Specular>,
+}
+
+/// The material at one surface point.
+#[derive(Clone, Copy, Debug)]
+pub struct PointMaterial {
+    /// The diffusion profile there.
+    pub profile: Profile,
+    /// K_d there, when it comes from a texture (selects the local-integral tables).
+    pub kd: Option<Vec3>,
+}
+
+fn scalar_at(p: &ScalarParam, uv: Vec2) -> Vec3 {
+    match p {
+        ScalarParam::Constant(v) => *v,
+        ScalarParam::Texture { texture, min, max } => {
+            let t = texture.sample(uv).clamp(Vec3::ZERO, Vec3::ONE);
+            let ratio = (max / min).ln();
+            Vec3::new(
+                min * (ratio * t.x).exp(),
+                min * (ratio * t.y).exp(),
+                min * (ratio * t.z).exp(),
+            )
+        }
+    }
+}
+
+impl TranslucentShader {
+    /// True if the profile varies over the surface (needs UVs and per-point profiles).
+    pub fn is_textured(&self) -> bool {
+        match &self.params {
+            Params::Fixed(_) => false,
+            Params::Reflectance { kd, distance, .. } => {
+                matches!(kd, KdSource::Texture(..))
+                    || matches!(
+                        distance,
+                        Distance::MeanFreePath(ScalarParam::Texture { .. })
+                            | Distance::DiffuseMeanFreePath(ScalarParam::Texture { .. })
+                    )
+            }
+        }
+    }
+
+    /// The profile used where nothing varies (and for sample spacing decisions).
+    pub fn base_profile(&self) -> &Profile {
+        match &self.params {
+            Params::Fixed(p) | Params::Reflectance { base: p, .. } => p,
+        }
+    }
+
+    /// The material at texture coordinate `uv` (ignored when nothing is textured).
+    pub fn at(&self, uv: Vec2) -> Result<PointMaterial, ParamError> {
+        let (base, kd, distance) = match &self.params {
+            Params::Fixed(p) => {
+                return Ok(PointMaterial {
+                    profile: *p,
+                    kd: None,
+                });
+            }
+            Params::Reflectance { base, kd, distance } => (base, kd, distance),
+        };
+        let (albedo, kd_value) = match kd {
+            KdSource::Constant(a) => (*a, None),
+            KdSource::Texture(t, inverter) => {
+                let v = t.sample(uv).clamp(Vec3::splat(0.001), Vec3::splat(0.999));
+                (
+                    [
+                        inverter.albedo(v.x),
+                        inverter.albedo(v.y),
+                        inverter.albedo(v.z),
+                    ],
+                    Some(v),
+                )
+            }
+        };
+        let sigma_t = match distance {
+            Distance::MeanFreePath(p) => {
+                let l = scalar_at(p, uv);
+                [1.0 / l.x as f64, 1.0 / l.y as f64, 1.0 / l.z as f64]
+            }
+            Distance::DiffuseMeanFreePath(p) => {
+                let l = scalar_at(p, uv);
+                let st = |c: usize| (1.0 / l[c] as f64) / (3.0 * (1.0 - albedo[c])).sqrt();
+                [st(0), st(1), st(2)]
+            }
+        };
+        Ok(PointMaterial {
+            profile: base.with_albedo_and_extinction(albedo, sigma_t)?,
+            kd: kd_value,
+        })
+    }
+
+    /// The local-integral source for smoothing radius `alpha` and threshold `ell_min`.
+    pub fn local_term(&self, alpha: f32, ell_min: f32) -> Result<LocalTerm, ParamError> {
+        let textured_kd = matches!(
+            &self.params,
+            Params::Reflectance {
+                kd: KdSource::Texture(..),
+                ..
+            }
+        );
+        if textured_kd {
+            let eta = self.base_profile().eta();
+            Ok(LocalTerm::Levels {
+                levels: (0..=KD_LEVELS).map(|_| OnceLock::new()).collect(),
+                alpha,
+                ell_min,
+                eta,
+            })
+        } else {
+            Ok(LocalTerm::Single(LocalIntegralTable::new(
+                self.base_profile(),
+                alpha,
+                ell_min,
+            )?))
+        }
+    }
+}
+
+/// Where K comes from for one material.
+#[derive(Debug)]
+pub enum LocalTerm {
+    /// Constant K_d: one table over ℓ.
+    Single(LocalIntegralTable),
+    /// Texture-mapped K_d: tables at evenly spaced K_d, built on first use.
+    Levels {
+        /// `levels[i]` is the table for K_d = i / KD_LEVELS (clamped into (0, 1)).
+        levels: Vec<OnceLock<LocalIntegralTable>>,
+        /// Smoothing radius.
+        alpha: f32,
+        /// ℓ_min.
+        ell_min: f32,
+        /// Relative index of refraction.
+        eta: f32,
+    },
+}
+
+impl LocalTerm {
+    /// K at a surface point.
+    pub fn lookup(&self, point: &PointMaterial) -> Vec3 {
+        let ell = point.profile.mean_free_path();
+        match self {
+            LocalTerm::Single(table) => table.lookup(ell),
+            LocalTerm::Levels {
+                levels,
+                alpha,
+                ell_min,
+                eta,
+            } => {
+                let kd = point.kd.unwrap_or(Vec3::splat(0.5));
+                let table = |i: usize| {
+                    levels[i].get_or_init(|| {
+                        let v = (i as f32 / KD_LEVELS as f32).clamp(0.001, 0.999);
+                        // Both validated at construction: K_d in (0, 1), α > 0, ℓ_min ≥ 0.
+                        let p = Profile::from_reflectance(
+                            Vec3::splat(v),
+                            CoreDistance::MeanFreePath(Vec3::ONE),
+                            *eta,
+                        )
+                        .expect("K_d level in (0, 1)");
+                        LocalIntegralTable::new(&p, *alpha, *ell_min)
+                            .expect("validated smoothing radius")
+                    })
+                };
+                let mut k = Vec3::ZERO;
+                for c in 0..3 {
+                    let x = kd[c].clamp(0.0, 1.0) * KD_LEVELS as f32;
+                    let i = (x as usize).min(KD_LEVELS - 1);
+                    let t = x - i as f32;
+                    let lo = table(i).lookup_channel(c, ell[c]);
+                    let hi = table(i + 1).lookup_channel(c, ell[c]);
+                    k[c] = lo + (hi - lo) * t;
+                }
+                k
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::TranslucentMaterial;
+    use std::path::PathBuf;
+
+    fn texture(values: &[Vec3], width: u32) -> Arc<Texture> {
+        Arc::new(Texture {
+            path: PathBuf::from("test.png"),
+            width,
+            height: values.len() as u32 / width,
+            texels: values.to_vec(),
+        })
+    }
+
+    fn translucent(medium: Medium) -> TranslucentShader {
+        match Shader::new(&Material::Translucent(TranslucentMaterial {
+            name: "m".into(),
+            medium,
+            specular: None,
+        }))
+        .unwrap()
+        {
+            Shader::Translucent(t) => *t,
+            Shader::Lambert { .. } => unreachable!(),
+        }
+    }
+
+    #[test]
+    fn constant_reflectance_matches_the_core() {
+        let kd = Vec3::new(0.8, 0.5, 0.3);
+        let shader = translucent(Medium::Reflectance {
+            kd: ColorParam::Constant(kd),
+            distance: Distance::MeanFreePath(ScalarParam::Constant(Vec3::splat(0.2))),
+            eta: 1.3,
+        });
+        let p = shader.at(Vec2::ZERO).unwrap().profile;
+        assert!((p.total_reflectance() - kd).abs().max_element() < 1e-5);
+        assert!((p.mean_free_path() - Vec3::splat(0.2)).abs().max_element() < 1e-6);
+        assert!(!shader.is_textured());
+    }
+
+    #[test]
+    fn textured_mean_free_path_maps_logarithmically() {
+        // A 2×1 texture: t = 0 on the left, t = 1 on the right; clamp-free lookups at texel
+        // centres.
+        let tex = texture(&[Vec3::ZERO, Vec3::ONE], 2);
+        let shader = translucent(Medium::Reflectance {
+            kd: ColorParam::Constant(Vec3::splat(0.6)),
+            distance: Distance::MeanFreePath(ScalarParam::Texture {
+                texture: tex,
+                min: 0.01,
+                max: 1.0,
+            }),
+            eta: 1.3,
+        });
+        assert!(shader.is_textured());
+        let left = shader
+            .at(Vec2::new(0.25, 0.5))
+            .unwrap()
+            .profile
+            .mean_free_path();
+        let right = shader
+            .at(Vec2::new(0.75, 0.5))
+            .unwrap()
+            .profile
+            .mean_free_path();
+        assert!(
+            (left.x - 0.01).abs() < 1e-6 && (right.x - 1.0).abs() < 1e-5,
+            "{left} {right}"
+        );
+        // K from the single table equals the table's own lookup at that ℓ.
+        let term = shader.local_term(0.1, 1e-4).unwrap();
+        let point = shader.at(Vec2::new(0.75, 0.5)).unwrap();
+        let LocalTerm::Single(table) = &term else {
+            panic!("expected a single table")
+        };
+        assert_eq!(
+            term.lookup(&point),
+            table.lookup(point.profile.mean_free_path())
+        );
+    }
+
+    #[test]
+    fn textured_reflectance_interpolates_tables_between_levels() {
+        let tex = texture(&[Vec3::new(0.3, 0.55, 0.9)], 1);
+        let shader = translucent(Medium::Reflectance {
+            kd: ColorParam::Texture(tex),
+            distance: Distance::MeanFreePath(ScalarParam::Constant(Vec3::splat(0.05))),
+            eta: 1.4,
+        });
+        let point = shader.at(Vec2::splat(0.5)).unwrap();
+        assert!(
+            (point.profile.total_reflectance() - Vec3::new(0.3, 0.55, 0.9))
+                .abs()
+                .max_element()
+                < 1e-4
+        );
+        let alpha = 0.07;
+        let k = shader
+            .local_term(alpha, alpha / 1024.0)
+            .unwrap()
+            .lookup(&point);
+        // Against a table built for exactly this material.
+        let exact = LocalIntegralTable::new(&point.profile, alpha, alpha / 1024.0)
+            .unwrap()
+            .exact(point.profile.mean_free_path());
+        assert!(
+            ((k - exact) / exact).abs().max_element() < 0.01,
+            "{k} vs {exact}"
+        );
+    }
+
+    #[test]
+    fn invalid_parameters_name_the_material() {
+        let m = Material::Translucent(TranslucentMaterial {
+            name: "wax".into(),
+            medium: Medium::Coefficients {
+                sigma_a: Vec3::new(1.0, -1.0, 1.0),
+                sigma_s_prime: Vec3::ONE,
+                eta: 1.3,
+            },
+            specular: None,
+        });
+        let err = Shader::new(&m).unwrap_err();
+        assert!(err.contains("wax") && err.contains("sigma_a"), "{err}");
+        let m = Material::Translucent(TranslucentMaterial {
+            name: "stone".into(),
+            medium: Medium::Preset {
+                name: "granite".into(),
+                mm_per_unit: 1.0,
+            },
+            specular: None,
+        });
+        assert!(Shader::new(&m).unwrap_err().contains("granite"));
+    }
+}
