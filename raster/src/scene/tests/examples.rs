@@ -367,41 +367,6 @@ fn files_on_disk_resolve_next_to_the_scene_and_errors_name_them() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Deterministic byte mutations of a valid scene never panic (they load or fail cleanly).
-#[test]
-fn mutated_scenes_never_panic() {
-    let text = format!(
-        "{BASE}[output]\nexr = 'a.exr'\nlayers = ['depth']\n[render]\nspacing = 0.05\n\
-         [material.t]\ntype = 'translucent'\nkd = {{ texture = 'ramp.png' }}\n\
-         diffuse_mean_free_path = {{ texture = 'ramp.png', min = 0.1, max = 2 }}\neta = 1.3\n\
-         [[object]]\nobj = 'quad.obj'\nmaterial = 't'\n"
-    );
-    assert!(load(&text).is_ok(), "{:?}", load(&text).err());
-    let bytes = text.as_bytes();
-    let replacements = b"0-.[]{}=\"'\n#ae,9 ";
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    for _ in 0..3000 {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        let mut m = bytes.to_vec();
-        let at = (state % m.len() as u64) as usize;
-        let with = replacements[((state >> 32) % replacements.len() as u64) as usize];
-        match (state >> 40) % 3 {
-            0 => m[at] = with,
-            1 => {
-                m.remove(at);
-            }
-            _ => m.insert(at, with),
-        }
-        if let Ok(t) = std::str::from_utf8(&m)
-            && let Err(e) = load(t)
-        {
-            assert!(e.to_string().starts_with("t.toml"), "{e}");
-        }
-    }
-}
-
 /// Every key the parser accepts is documented in `docs/scene-format.md`: the lists come from
 /// the parser's own "unknown key, expected one of …" messages, one per table.
 #[test]

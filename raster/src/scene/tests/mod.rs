@@ -8,6 +8,7 @@
 mod examples;
 mod ranges;
 mod references;
+mod robustness;
 mod structure;
 
 use std::borrow::Cow;
