@@ -1,5 +1,43 @@
 //! Scenes: the TOML format, OBJ meshes and built-in shapes, and the default scene.
+//!
+//! The format is documented in `docs/scene-format.md`. Loading goes text → serde structures
+//! mirroring the tables (`format.rs`; unknown keys and wrong types rejected) → value checks,
+//! name resolution and file loading (`settings.rs`, `objects.rs`, `materials.rs`,
+//! `lights.rs`) → [`Scene`] (the shared, validated data model of `model.rs`). Every failure is a
+//! [`SceneError`] naming the file, line, column and key. Files are read through a
+//! [`SceneOrigin`], so the built-in [`default_scene`] loads from memory.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! let scene = lucent_raster::scene::load_scene(Path::new("scenes/sphere-shadow.toml"))?;
+//! println!("{} objects", scene.objects.len());
+//! # Ok::<(), lucent_raster::scene::SceneError>(())
+//! ```
 
+mod check;
+mod default;
+mod error;
+mod format;
+mod lights;
+mod load;
+mod materials;
+pub mod mesh;
 mod model;
+pub mod obj;
+mod objects;
+mod origin;
+mod settings;
+pub mod shapes;
 
+#[cfg(test)]
+mod tests;
+
+pub use default::{DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML, default_scene, default_scene_origin};
+pub use error::{SceneError, SceneErrorKind};
+pub use lights::LIGHT_TYPES;
+pub use load::{MAX_SCENE_BYTES, load_scene, parse_scene};
+pub use materials::PRESET_NAMES;
 pub use model::*;
+pub use objects::SHAPES;
+pub use origin::{MAX_FILE_BYTES, SceneOrigin};
+pub use settings::{DEFAULT_RESOLUTION, LAYERS, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, METHODS};

@@ -1,0 +1,409 @@
+//! `[material.NAME]` tables → [`Material`]: which keys go together, their ranges, and texture
+//! loading (shared between materials that name the same file).
+//!
+//! A translucent material is given in exactly one of three ways (see `docs/scene-format.md`
+//! and the project's physics reference §2): a measured preset of Jensen et al. 2001 with the
+//! scene's scale, explicit coefficients, or the artist parameters of Jensen & Buhler 2002
+//! (diffuse reflectance K_d and one named mean free path).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use toml::Spanned;
+
+use super::check::{Check, Checked};
+use super::error::SceneErrorKind;
+use super::format::{RawMaterial, RawParam, RawTextureRef};
+use super::model::{
+    ColorParam, Distance, Material, Medium, ScalarParam, Specular, TranslucentMaterial,
+};
+use super::origin::SceneOrigin;
+use crate::texture::{Texture, TextureEncoding};
+
+/// The measured materials of Jensen et al. 2001 (Table of σ_s′, σ_a in mm⁻¹, as carried by
+/// pbrt), accepted by `preset`, matched case-insensitively.
+pub const PRESET_NAMES: [&str; 11] = [
+    "apple",
+    "chicken1",
+    "chicken2",
+    "cream",
+    "ketchup",
+    "marble",
+    "potato",
+    "skimmilk",
+    "skin1",
+    "skin2",
+    "wholemilk",
+];
+
+/// Material types accepted by `type`.
+const MATERIAL_TYPES: [&str; 2] = ["translucent", "lambert"];
+
+/// Loads each texture once per (file, encoding).
+pub(crate) struct TextureCache<'o> {
+    origin: &'o SceneOrigin,
+    loaded: HashMap<(String, TextureEncoding), Arc<Texture>>,
+}
+
+impl<'o> TextureCache<'o> {
+    /// An empty cache reading through `origin`.
+    pub fn new(origin: &'o SceneOrigin) -> Self {
+        TextureCache {
+            origin,
+            loaded: HashMap::new(),
+        }
+    }
+
+    fn get(
+        &mut self,
+        c: &Check,
+        key: &str,
+        file: &Spanned<String>,
+        encoding: TextureEncoding,
+    ) -> Checked<Arc<Texture>> {
+        let name = file.get_ref().clone();
+        if let Some(t) = self.loaded.get(&(name.clone(), encoding)) {
+            return Ok(Arc::clone(t));
+        }
+        let path = self.origin.resolve(&name);
+        let bytes = self.origin.read(&name).map_err(|why| {
+            c.at(
+                SceneErrorKind::Io,
+                key,
+                file,
+                format!("cannot read texture {}: {why}", path.display()),
+            )
+        })?;
+        let texture = Texture::from_png_bytes(&bytes, &path, encoding)
+            .map_err(|e| c.at(SceneErrorKind::Texture, key, file, e.to_string()))?;
+        let texture = Arc::new(texture);
+        self.loaded.insert((name, encoding), Arc::clone(&texture));
+        Ok(texture)
+    }
+}
+
+/// A built material and, if it uses a texture, the key of the first textured parameter (the
+/// objects that use it must have UVs).
+pub(crate) struct BuiltMaterial {
+    pub material: Material,
+    pub texture_key: Option<&'static str>,
+}
+
+/// Builds one material from its table.
+pub(crate) fn build_material(
+    c: &Check,
+    name: &str,
+    raw: &Spanned<RawMaterial>,
+    textures: &mut TextureCache,
+) -> Checked<BuiltMaterial> {
+    let m = raw.get_ref();
+    let key = |k: &str| format!("material.{name}.{k}");
+    match m.kind.get_ref().as_str() {
+        "lambert" => {
+            let what = "a lambert material";
+            c.forbid(&key("preset"), &m.preset, what)?;
+            c.forbid(&key("mm_per_unit"), &m.mm_per_unit, what)?;
+            c.forbid(&key("sigma_a"), &m.sigma_a, what)?;
+            c.forbid(&key("sigma_s_prime"), &m.sigma_s_prime, what)?;
+            c.forbid(&key("eta"), &m.eta, what)?;
+            c.forbid(&key("kd"), &m.kd, what)?;
+            c.forbid(&key("mean_free_path"), &m.mean_free_path, what)?;
+            c.forbid(
+                &key("diffuse_mean_free_path"),
+                &m.diffuse_mean_free_path,
+                what,
+            )?;
+            c.forbid(&key("specular"), &m.specular, what)?;
+            let albedo = c.require(&key("albedo"), &m.albedo, raw, what)?;
+            let albedo = c.rgb(
+                &key("albedo"),
+                albedo,
+                |x| (0.0..=1.0).contains(&x),
+                "must be in [0, 1]",
+            )?;
+            Ok(BuiltMaterial {
+                material: Material::Lambert {
+                    name: name.to_string(),
+                    albedo,
+                },
+                texture_key: None,
+            })
+        }
+        "translucent" => {
+            c.forbid(&key("albedo"), &m.albedo, "a translucent material (use kd)")?;
+            let (medium, texture_key) = build_medium(c, name, raw, textures)?;
+            let specular = match &m.specular {
+                None => None,
+                Some(s) => {
+                    let s = s.get_ref();
+                    Some(Specular {
+                        exponent: c.positive(&key("specular.exponent"), &s.exponent)?,
+                        strength: match &s.strength {
+                            Some(v) => c.non_negative(&key("specular.strength"), v)?,
+                            None => 1.0,
+                        },
+                    })
+                }
+            };
+            Ok(BuiltMaterial {
+                material: Material::Translucent(TranslucentMaterial {
+                    name: name.to_string(),
+                    medium,
+                    specular,
+                }),
+                texture_key,
+            })
+        }
+        other => Err(c.at(
+            SceneErrorKind::UnknownName,
+            &key("type"),
+            &m.kind,
+            format!(
+                "unknown material type `{other}` (expected one of: {})",
+                MATERIAL_TYPES.join(", ")
+            ),
+        )),
+    }
+}
+
+/// The three ways of giving a medium; exactly one must be used.
+fn build_medium(
+    c: &Check,
+    name: &str,
+    raw: &Spanned<RawMaterial>,
+    textures: &mut TextureCache,
+) -> Checked<(Medium, Option<&'static str>)> {
+    let m = raw.get_ref();
+    let key = |k: &str| format!("material.{name}.{k}");
+    const FORMS: &str = "a translucent material takes exactly one of: `preset` + `mm_per_unit`; \
+                         `sigma_a` + `sigma_s_prime` + `eta`; `kd` + (`mean_free_path` or \
+                         `diffuse_mean_free_path`) + `eta`";
+    // The first key of each form that is present, with its span.
+    let preset_form = m.preset.as_ref().map(|v| ("preset", v.span()));
+    let coeff_form = m
+        .sigma_a
+        .as_ref()
+        .map(|v| ("sigma_a", v.span()))
+        .or_else(|| {
+            m.sigma_s_prime
+                .as_ref()
+                .map(|v| ("sigma_s_prime", v.span()))
+        });
+    let artist_form =
+        m.kd.as_ref()
+            .map(|v| ("kd", v.span()))
+            .or_else(|| {
+                m.mean_free_path
+                    .as_ref()
+                    .map(|v| ("mean_free_path", v.span()))
+            })
+            .or_else(|| {
+                m.diffuse_mean_free_path
+                    .as_ref()
+                    .map(|v| ("diffuse_mean_free_path", v.span()))
+            });
+    let present: Vec<_> = [preset_form, coeff_form, artist_form]
+        .into_iter()
+        .flatten()
+        .collect();
+    match present.as_slice() {
+        [] => {
+            return Err(c.at(
+                SceneErrorKind::MissingKey,
+                &format!("material.{name}"),
+                raw,
+                format!("no scattering parameters: {FORMS}"),
+            ));
+        }
+        [(first, _), (second, span), ..] => {
+            return Err(c.src.error(
+                SceneErrorKind::Conflict,
+                span.clone(),
+                key(second),
+                format!("cannot be combined with `{first}`: {FORMS}"),
+            ));
+        }
+        [_] => {}
+    }
+    if let Some(preset) = &m.preset {
+        c.forbid(&key("eta"), &m.eta, "a preset (it has its own)")?;
+        let wanted = preset.get_ref().to_ascii_lowercase();
+        if !PRESET_NAMES.contains(&wanted.as_str()) {
+            return Err(c.at(
+                SceneErrorKind::UnknownName,
+                &key("preset"),
+                preset,
+                format!(
+                    "unknown preset `{}` (expected one of: {})",
+                    preset.get_ref(),
+                    PRESET_NAMES.join(", ")
+                ),
+            ));
+        }
+        let scale = c.require(&key("mm_per_unit"), &m.mm_per_unit, raw, "a preset")?;
+        let mm_per_unit = c.positive(&key("mm_per_unit"), scale)?;
+        let medium = Medium::Preset {
+            name: wanted,
+            mm_per_unit,
+        };
+        return Ok((medium, None));
+    }
+    if m.sigma_a.is_some() || m.sigma_s_prime.is_some() {
+        let what = "explicit coefficients";
+        c.forbid(&key("mm_per_unit"), &m.mm_per_unit, what)?;
+        let sa = c.require(&key("sigma_a"), &m.sigma_a, raw, what)?;
+        let ss = c.require(&key("sigma_s_prime"), &m.sigma_s_prime, raw, what)?;
+        let positive = |x: f32| x > 0.0;
+        let sigma_a = c.rgb(&key("sigma_a"), sa, positive, "must be greater than 0")?;
+        let sigma_s_prime = c.rgb(
+            &key("sigma_s_prime"),
+            ss,
+            positive,
+            "must be greater than 0",
+        )?;
+        let eta = eta(c, &key("eta"), &m.eta, raw, what)?;
+        let medium = Medium::Coefficients {
+            sigma_a,
+            sigma_s_prime,
+            eta,
+        };
+        return Ok((medium, None));
+    }
+    let what = "kd and a mean free path";
+    c.forbid(&key("mm_per_unit"), &m.mm_per_unit, what)?;
+    let kd_raw = c.require(&key("kd"), &m.kd, raw, what)?;
+    let kd = color_param(c, &key("kd"), kd_raw, textures)?;
+    let distance = match (&m.mean_free_path, &m.diffuse_mean_free_path) {
+        (Some(_), Some(d)) => {
+            return Err(c.at(
+                SceneErrorKind::Conflict,
+                &key("diffuse_mean_free_path"),
+                d,
+                "cannot be combined with `mean_free_path`: give one distance",
+            ));
+        }
+        (Some(u), None) => {
+            Distance::MeanFreePath(distance_param(c, &key("mean_free_path"), u, textures)?)
+        }
+        (None, Some(d)) => Distance::DiffuseMeanFreePath(distance_param(
+            c,
+            &key("diffuse_mean_free_path"),
+            d,
+            textures,
+        )?),
+        (None, None) => {
+            return Err(c.at(
+                SceneErrorKind::MissingKey,
+                &key("mean_free_path"),
+                raw,
+                "missing required key: `kd` needs `mean_free_path` (ℓ_u = 1/σ_t′) or \
+                 `diffuse_mean_free_path` (ℓ_d = 1/σ_tr)",
+            ));
+        }
+    };
+    let eta = eta(c, &key("eta"), &m.eta, raw, what)?;
+    let textured = [
+        matches!(kd, ColorParam::Texture(_)).then_some("kd"),
+        match &distance {
+            Distance::MeanFreePath(ScalarParam::Texture { .. }) => Some("mean_free_path"),
+            Distance::DiffuseMeanFreePath(ScalarParam::Texture { .. }) => {
+                Some("diffuse_mean_free_path")
+            }
+            _ => None,
+        },
+    ];
+    Ok((
+        Medium::Reflectance { kd, distance, eta },
+        textured.into_iter().flatten().next(),
+    ))
+}
+
+/// The relative index of refraction: required, ≥ 1.
+fn eta(
+    c: &Check,
+    key: &str,
+    v: &Option<Spanned<f64>>,
+    table: &Spanned<RawMaterial>,
+    what: &str,
+) -> Checked<f32> {
+    let v = c.require(key, v, table, what)?;
+    c.num_where(
+        key,
+        v,
+        |x| x >= 1.0,
+        "must be at least 1 (relative index of refraction, inside / outside)",
+    )
+}
+
+/// K_d: `[r, g, b]` / a number in (0, 1), or `{ texture = "file.png" }` (sRGB-decoded).
+fn color_param(
+    c: &Check,
+    key: &str,
+    v: &Spanned<RawParam>,
+    textures: &mut TextureCache,
+) -> Checked<ColorParam> {
+    match v.get_ref() {
+        RawParam::Constant(components) => {
+            let spanned = Spanned::new(v.span(), components.clone());
+            let kd = c.rgb(
+                key,
+                &spanned,
+                |x| x > 0.0 && x < 1.0,
+                "must be strictly between 0 and 1",
+            )?;
+            Ok(ColorParam::Constant(kd))
+        }
+        RawParam::Texture(t) => {
+            forbid_range(c, key, t, "a colour texture")?;
+            let texture = textures.get(
+                c,
+                &format!("{key}.texture"),
+                &t.texture,
+                TextureEncoding::Srgb,
+            )?;
+            Ok(ColorParam::Texture(texture))
+        }
+    }
+}
+
+/// A distance: a positive number / `[r, g, b]`, or `{ texture, min, max }` (linear data).
+fn distance_param(
+    c: &Check,
+    key: &str,
+    v: &Spanned<RawParam>,
+    textures: &mut TextureCache,
+) -> Checked<ScalarParam> {
+    match v.get_ref() {
+        RawParam::Constant(components) => {
+            let spanned = Spanned::new(v.span(), components.clone());
+            let d = c.rgb(key, &spanned, |x| x > 0.0, "must be greater than 0")?;
+            Ok(ScalarParam::Constant(d))
+        }
+        RawParam::Texture(t) => {
+            let missing = |k: &str| {
+                c.at(
+                    SceneErrorKind::MissingKey,
+                    &format!("{key}.{k}"),
+                    v,
+                    "a distance texture needs `min` and `max` (distance at 0 and at 1)",
+                )
+            };
+            let min = t.min.as_ref().ok_or_else(|| missing("min"))?;
+            let max = t.max.as_ref().ok_or_else(|| missing("max"))?;
+            let min = c.positive(&format!("{key}.min"), min)?;
+            let max = c.positive(&format!("{key}.max"), max)?;
+            let texture = textures.get(
+                c,
+                &format!("{key}.texture"),
+                &t.texture,
+                TextureEncoding::Linear,
+            )?;
+            Ok(ScalarParam::Texture { texture, min, max })
+        }
+    }
+}
+
+fn forbid_range(c: &Check, key: &str, t: &RawTextureRef, what: &str) -> Checked<()> {
+    c.forbid(&format!("{key}.min"), &t.min, what)?;
+    c.forbid(&format!("{key}.max"), &t.max, what)
+}

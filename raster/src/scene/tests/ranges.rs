@@ -1,0 +1,132 @@
+//! Values out of range, NaN and infinities, per table.
+
+use super::*;
+
+use SceneErrorKind::OutOfRange as R;
+
+#[test]
+fn camera_values() {
+    let cam = |extra: &str| edit("fov = 30", &format!("fov = 30\n{extra}"));
+    expect_all! { R;
+        edit("fov = 30", "fov = 0") => "fov = 0", "camera.fov", "(0, 180)";
+        edit("fov = 30", "fov = 180") => "fov = 180", "camera.fov", "(0, 180)";
+        edit("fov = 30", "fov = nan") => "fov = nan", "camera.fov", "finite";
+        edit("fov = 30", "fov = -inf") => "fov = -inf", "camera.fov", "finite";
+        edit("fov = 30", "fov = 1e300") => "fov = 1e300", "camera.fov", "too large";
+        cam("width = 0") => "width = 0", "camera.width", "1..=16384";
+        cam("height = 16385") => "height", "camera.height", "1..=16384";
+        cam("width = 10000\nheight = 10000") => "height = 10000", "camera.height", "pixels";
+        edit("target = [0, 0, 0.5]", "target = [0, -5, 1]") => "target", "camera.target", "differ";
+        cam("up = [0, 10, -1]") => "up = ", "camera.up", "parallel";
+        cam("up = [0, 0, 0]") => "up = ", "camera.up", "zero";
+        edit("position = [0, -5, 1]", "position = [0, -inf, 1]") => "position", "camera.position", "finite";
+    }
+}
+
+#[test]
+fn object_values() {
+    let sphere = |extra: &str| edit("radius = 1", &format!("radius = 1\n{extra}"));
+    expect_all! { R;
+        edit("radius = 1", "radius = -1") => "radius = -1", "object[0].radius", "greater than 0";
+        sphere("segments = 2") => "segments", "object[0].segments", "3..=4096";
+        sphere("segments = 5000") => "segments", "object[0].segments", "3..=4096";
+        sphere("scale = 0") => "scale", "object[0].scale", "greater than 0";
+        // Underflows to 0 as an f32.
+        sphere("scale = 1e-46") => "scale", "object[0].scale", "greater than 0";
+        sphere("rotate = [0, nan, 0]") => "rotate", "object[0].rotate", "finite";
+        sphere("translate = [1e39, 0, 0]") => "translate", "object[0].translate", "finite";
+        sphere("name = ' '") => "name", "object[0].name", "empty";
+        edit("shape = \"sphere\"\nradius = 1", "shape = 'box'\nsize = [1, 0, 1]") => "size", "object[0].size", "greater than 0";
+    }
+}
+
+#[test]
+fn material_values() {
+    let coeffs = |sa: &str, ss: &str, eta: &str| {
+        edit(
+            PRESET,
+            &format!("sigma_a = {sa}\nsigma_s_prime = {ss}\neta = {eta}"),
+        )
+    };
+    let artist = |kd: &str, d: &str| edit(PRESET, &format!("kd = {kd}\n{d}\neta = 1.3"));
+    let dtex = "diffuse_mean_free_path = { texture = 'ramp.png', min = -1, max = 2 }";
+    let lambert = |albedo: &str| {
+        edit(
+            "type = \"translucent\"\npreset = \"marble\"\nmm_per_unit = 10",
+            &format!("type = 'lambert'\nalbedo = {albedo}"),
+        )
+    };
+    expect_all! { R;
+        edit("mm_per_unit = 10", "mm_per_unit = 0") => "mm_per_unit", "material.m.mm_per_unit", "greater than 0";
+        coeffs("[0.1, 0, 0.1]", "1", "1.3") => "sigma_a", "material.m.sigma_a", "greater than 0";
+        coeffs("0.1", "-2", "1.3") => "sigma_s_prime", "material.m.sigma_s_prime", "greater than 0";
+        coeffs("0.1", "2", "0.9") => "eta", "material.m.eta", "at least 1";
+        coeffs("0.1", "inf", "1.3") => "sigma_s_prime", "material.m.sigma_s_prime", "finite";
+        coeffs("0.1", "2", "nan") => "eta", "material.m.eta", "finite";
+        artist("[0.5, 1.0, 0.5]", "mean_free_path = 1") => "kd", "material.m.kd", "strictly between 0 and 1";
+        artist("0", "mean_free_path = 1") => "kd", "material.m.kd", "strictly between";
+        artist("0.5", "mean_free_path = [1, 0, 1]") => "mean_free_path", "material.m.mean_free_path", "greater than 0";
+        artist("0.5", dtex) => "diffuse_mean_free_path", "material.m.diffuse_mean_free_path.min", "greater than 0";
+        edit("mm_per_unit = 10", "mm_per_unit = 10\nspecular = { exponent = 0 }")
+            => "specular", "material.m.specular.exponent", "greater than 0";
+        edit("mm_per_unit = 10", "mm_per_unit = 10\nspecular = { exponent = 9, strength = -1 }")
+            => "specular", "material.m.specular.strength", "at least 0";
+        lambert("1.5") => "albedo", "material.m.albedo", "[0, 1]";
+    }
+}
+
+#[test]
+fn light_values() {
+    let point = |extra: &str| edit("intensity = 20", &format!("intensity = 20\n{extra}"));
+    let spot = |inner: &str, outer: &str, dir: &str| {
+        edit(
+            "type = \"point\"",
+            &format!(
+                "type = \"spot\"\ndirection = {dir}\ninner_angle = {inner}\nouter_angle = {outer}"
+            ),
+        )
+    };
+    let sphere = |extra: &str| {
+        edit(
+            "type = \"point\"\nposition = [0, -3, 5]",
+            &format!("type = 'sphere'\ncenter = [0, -3, 5]\n{extra}"),
+        )
+    };
+    let directional = edit(
+        "type = \"point\"\nposition = [0, -3, 5]\nintensity = 20",
+        "type = 'directional'\ndirection = [0, 0, -1]\nirradiance = -2",
+    );
+    expect_all! { R;
+        edit("intensity = 20", "intensity = -1") => "intensity", "light[0].intensity", "at least 0";
+        edit("intensity = 20", "intensity = inf") => "intensity", "light[0].intensity", "finite";
+        point("color = [1, nan, 1]") => "color", "light[0].color", "finite";
+        point("color = -1") => "color", "light[0].color", "at least 0";
+        spot("30", "20", "[0, 0, -1]") => "inner_angle", "light[0].inner_angle", "outer_angle";
+        spot("10", "180", "[0, 0, -1]") => "outer_angle", "light[0].outer_angle", "(0, 180)";
+        spot("10", "20", "[0, 0, 0]") => "direction", "light[0].direction", "zero";
+        sphere("radius = 0") => "radius = 0", "light[0].radius", "greater than 0";
+        sphere("radius = 1\nsamples = 0") => "samples", "light[0].samples", "1..=4096";
+        directional => "irradiance", "light[0].irradiance", "at least 0";
+    }
+}
+
+#[test]
+fn render_and_output_values() {
+    let render = |line: &str| append(&format!("[render]\n{line}\n"));
+    expect_all! { R;
+        render("aa = 0") => "aa", "render.aa", "1..=8";
+        render("aa = 9") => "aa", "render.aa", "1..=8";
+        render("samples = 0") => "samples", "render.samples", "1..=";
+        render("samples = 100000000") => "samples", "render.samples", "1..=";
+        render("epsilon = -0.1") => "epsilon", "render.epsilon", "at least 0";
+        render("cull_tolerance = 1") => "cull_tolerance", "render.cull_tolerance", "[0, 1)";
+        render("ell_min = 0") => "ell_min", "render.ell_min", "greater than 0";
+        render("exposure = 100") => "exposure", "render.exposure", "stops";
+        render("threads = 0") => "threads", "render.threads", "1..=";
+        render("seed = -1") => "seed", "render.seed", "0..=";
+        render("smoothing = nan") => "smoothing", "render.smoothing", "finite";
+        // A sphere of area 4π with samples 1e-4 apart: up to 1.45e9 samples.
+        render("spacing = 1e-4") => "spacing", "render.spacing", "units";
+        append("[output]\npng = ''\n") => "png", "output.png", "empty";
+    }
+}
