@@ -1,1 +1,3 @@
 //! Blue-noise irradiance sample placement over triangle meshes.
+
+pub mod rng;
