@@ -160,7 +160,7 @@ impl Builder<'_> {
         } else {
             2
         };
-        if !(extent[axis] > 0.0) {
+        if extent[axis].is_nan() || extent[axis] <= 0.0 {
             // All centroids coincide: no plane separates them. Split by position in the list.
             return (n > MAX_LEAF).then_some(n / 2);
         }

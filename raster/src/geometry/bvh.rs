@@ -133,7 +133,7 @@ impl Bvh {
         let Some(ray) = Ray::new(origin, dir) else {
             return false;
         };
-        if !(t_max > 0.0) || self.nodes.is_empty() {
+        if t_max.is_nan() || t_max <= 0.0 || self.nodes.is_empty() {
             return false;
         }
         let visit = |n: &BvhNode| {
@@ -201,7 +201,7 @@ impl Bvh {
     /// [`Bvh::occluded`]) hit nothing.
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
         let ray = Ray::new(origin, dir)?;
-        if !(t_max > 0.0) || self.nodes.is_empty() {
+        if t_max.is_nan() || t_max <= 0.0 || self.nodes.is_empty() {
             return None;
         }
         let visit = |n: &BvhNode, limit: f32| {
@@ -377,10 +377,10 @@ impl Bvh {
                     end <= n_tris,
                     "leaf {index} covers slots {first}..{end} of {n_tris}"
                 );
-                for slot in first..end {
+                for (slot, tri) in self.triangles.iter().enumerate().take(end).skip(first) {
                     ensure!(!covered[slot], "slot {slot} in two leaves");
                     covered[slot] = true;
-                    let tb = Aabb::from_triangle(&self.triangles[slot]);
+                    let tb = Aabb::from_triangle(tri);
                     ensure!(
                         bounds.contains(&tb),
                         "leaf {index} bounds {bounds:?} miss slot {slot} box {tb:?}"

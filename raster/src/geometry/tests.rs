@@ -10,7 +10,7 @@ use crate::sampling::rng::Pcg32;
 /// The reference: every triangle in input order, the same triangle test, the same tie rule.
 fn brute_force(tris: &[[Vec3; 3]], o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
     let ray = Ray::new(o, d)?;
-    if !(t_max > 0.0) {
+    if t_max.is_nan() || t_max <= 0.0 {
         return None;
     }
     let mut best: Option<Hit> = None;
