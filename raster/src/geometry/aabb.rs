@@ -1,7 +1,7 @@
 //! Axis-aligned bounding boxes: the bounds stored in BVH nodes, their surface area for the SAH,
 //! and the conservative slab test used during traversal.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// An axis-aligned box `[min, max]`. The empty box has `min = +∞` and `max = −∞`, so that
 /// growing it by any point gives that point's box.
@@ -53,9 +53,10 @@ impl Aabb {
         self.max = self.max.max(p);
     }
 
-    /// The centre (meaningless for the empty box).
+    /// The centre (meaningless for the empty box). Halved before adding, so boxes near the
+    /// largest `f32` do not overflow.
     pub fn center(&self) -> Vec3 {
-        (self.min + self.max) * 0.5
+        self.min * 0.5 + self.max * 0.5
     }
 
     /// Half the surface area, `dx·dy + dy·dz + dz·dx` (0 for the empty box). The SAH only
@@ -94,7 +95,7 @@ const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f3
 const TINY_DIR: f32 = 1e-30;
 
 /// The reciprocal direction used by [`slab_test`], finite in every component.
-pub(crate) fn safe_inverse(dir: Vec3) -> Vec3 {
+pub(crate) fn safe_inverse(dir: Vec3) -> Vec3A {
     let fix = |d: f32| {
         if d.abs() < TINY_DIR {
             TINY_DIR.copysign(d)
@@ -102,18 +103,19 @@ pub(crate) fn safe_inverse(dir: Vec3) -> Vec3 {
             d
         }
     };
-    Vec3::new(1.0 / fix(dir.x), 1.0 / fix(dir.y), 1.0 / fix(dir.z))
+    Vec3A::new(1.0 / fix(dir.x), 1.0 / fix(dir.y), 1.0 / fix(dir.z))
 }
 
 /// The entry distance of the ray `origin + t·dir` into the box `[min, max]` if the ray overlaps
 /// it for some `t ∈ [0, t_max]`, else `None`. Conservative: with `inv_dir` from
 /// [`safe_inverse`], a box containing a point the ray passes through is never rejected.
+/// SIMD (`Vec3A`): the three slabs are computed at once.
 #[inline]
 pub(crate) fn slab_test(
-    min: Vec3,
-    max: Vec3,
-    origin: Vec3,
-    inv_dir: Vec3,
+    min: Vec3A,
+    max: Vec3A,
+    origin: Vec3A,
+    inv_dir: Vec3A,
     t_max: f32,
 ) -> Option<f32> {
     let t0 = (min - origin) * inv_dir;
@@ -126,6 +128,11 @@ pub(crate) fn slab_test(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The slab test on plain `Vec3`s.
+    fn slab(min: Vec3, max: Vec3, o: Vec3, inv: Vec3A, t_max: f32) -> Option<f32> {
+        slab_test(min.into(), max.into(), o.into(), inv, t_max)
+    }
 
     #[test]
     fn empty_box_is_union_identity() {
@@ -154,20 +161,17 @@ mod tests {
         let inv = safe_inverse(Vec3::X);
         assert!(inv.is_finite());
         let o = Vec3::new(-1.0, 0.0, 0.5);
-        assert_eq!(slab_test(min, max, o, inv, f32::INFINITY), Some(1.0));
+        assert_eq!(slab(min, max, o, inv, f32::INFINITY), Some(1.0));
         // Outside the y slab: miss.
-        assert_eq!(
-            slab_test(min, max, Vec3::new(-1.0, -0.1, 0.5), inv, 10.0),
-            None
-        );
+        assert_eq!(slab(min, max, Vec3::new(-1.0, -0.1, 0.5), inv, 10.0), None);
         // Starting inside gives entry distance 0; pointing away misses.
-        assert_eq!(slab_test(min, max, Vec3::splat(0.5), inv, 1.0), Some(0.0));
-        assert_eq!(slab_test(min, max, o, safe_inverse(-Vec3::X), 10.0), None);
+        assert_eq!(slab(min, max, Vec3::splat(0.5), inv, 1.0), Some(0.0));
+        assert_eq!(slab(min, max, o, safe_inverse(-Vec3::X), 10.0), None);
         // t_max shorter than the distance to the box.
-        assert_eq!(slab_test(min, max, o, inv, 0.5), None);
+        assert_eq!(slab(min, max, o, inv, 0.5), None);
         // A flat box (z extent 0) crossed perpendicularly.
         let flat_max = Vec3::new(1.0, 1.0, 0.0);
-        let hit = slab_test(
+        let hit = slab(
             min,
             flat_max,
             Vec3::new(0.5, 0.5, 2.0),

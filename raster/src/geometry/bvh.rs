@@ -17,7 +17,7 @@
 
 use std::fmt;
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::aabb::{Aabb, slab_test};
 use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES};
@@ -138,9 +138,9 @@ impl Bvh {
         }
         let visit = |n: &BvhNode| {
             slab_test(
-                Vec3::from_array(n.min),
-                Vec3::from_array(n.max),
-                ray.origin,
+                Vec3A::from_array(n.min),
+                Vec3A::from_array(n.max),
+                ray.origin_a,
                 ray.inv_dir,
                 t_max,
             )
@@ -206,9 +206,9 @@ impl Bvh {
         }
         let visit = |n: &BvhNode, limit: f32| {
             slab_test(
-                Vec3::from_array(n.min),
-                Vec3::from_array(n.max),
-                ray.origin,
+                Vec3A::from_array(n.min),
+                Vec3A::from_array(n.max),
+                ray.origin_a,
                 ray.inv_dir,
                 limit,
             )

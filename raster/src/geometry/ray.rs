@@ -11,7 +11,7 @@
 //! culled, and the hit distance is divided out rather than compared in scaled form (clearer,
 //! and the division only happens for triangles that pass the edge tests).
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::aabb::safe_inverse;
 
@@ -57,8 +57,10 @@ pub struct Ray {
     pub origin: Vec3,
     /// Direction (any non-zero length; distances are in units of it).
     pub dir: Vec3,
+    /// The origin again, in SIMD form for the slab test.
+    pub(crate) origin_a: Vec3A,
     /// Finite reciprocal of the direction, for the slab test.
-    pub(crate) inv_dir: Vec3,
+    pub(crate) inv_dir: Vec3A,
     /// Rows of the shear: the transformed vertex `(x, y, z)` of a vertex `a` (relative to the
     /// origin) is `(a·shear_x, a·shear_y, a·shear_z)`. `shear_x = e_kx − (d_kx/d_kz)·e_kz`,
     /// `shear_y = e_ky − (d_ky/d_kz)·e_kz`, `shear_z = e_kz / d_kz`, where `kz` is the axis of
@@ -96,6 +98,7 @@ impl Ray {
         Some(Ray {
             origin,
             dir,
+            origin_a: origin.into(),
             inv_dir: safe_inverse(dir),
             shear_x: axis(kx) - sx * axis(kz),
             shear_y: axis(ky) - sy * axis(kz),

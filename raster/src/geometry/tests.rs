@@ -265,6 +265,32 @@ fn non_finite_and_degenerate_triangles_are_harmless() {
 }
 
 #[test]
+fn coordinates_near_the_float_limit_do_not_break_the_tree() {
+    // Areas, centroids and SAH costs overflow to infinity here; the tree must stay valid and
+    // queries must not panic.
+    let big = f32::MAX * 0.9;
+    let mut tris = vec![
+        [
+            Vec3::splat(-big),
+            Vec3::new(big, -big, 0.0),
+            Vec3::new(0.0, big, big),
+        ],
+        [
+            Vec3::splat(big),
+            Vec3::new(-big, big, 0.0),
+            Vec3::new(0.0, -big, -big),
+        ],
+    ];
+    tris.extend(icosphere(2, Vec3::ZERO, 1.0));
+    tris.extend(icosphere(1, Vec3::splat(big * 0.5), big * 0.1));
+    let bvh = Bvh::build(&tris);
+    check(&bvh, &tris);
+    assert!(bvh.occluded(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z, 10.0));
+    let _ = bvh.intersect(Vec3::splat(-big), Vec3::ONE, f32::INFINITY);
+    let _ = bvh.occluded(Vec3::splat(big), -Vec3::ONE, f32::MAX);
+}
+
+#[test]
 fn identical_centroids_still_give_small_leaves() {
     // 1000 copies of one triangle: no plane separates them, yet leaves stay small and the
     // tree valid.

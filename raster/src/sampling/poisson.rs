@@ -152,7 +152,8 @@ impl Points {
 /// branches. Symmetric to the bit (`w(p, q) == w(q, p)`: the differences only change sign).
 struct Kernel {
     inv_d_max: f32,
-    d_min: f32,
+    /// `d_min / d_max`.
+    d_min_rel: f32,
 }
 
 /// Lanes of the weight sum: eight independent partial sums, added in a fixed order, so the
@@ -163,15 +164,19 @@ impl Kernel {
     fn new(d_max: f32, d_min: f32) -> Kernel {
         Kernel {
             inv_d_max: 1.0 / d_max,
-            d_min,
+            d_min_rel: d_min / d_max,
         }
     }
 
     #[inline(always)]
     fn weight(&self, p: Vec3, q: &[f32; 4]) -> f32 {
-        let (dx, dy, dz) = (q[0] - p.x, q[1] - p.y, q[2] - p.z);
-        let d = (dx * dx + dy * dy + dz * dz).sqrt().max(self.d_min);
-        let t = (1.0 - d * self.inv_d_max).max(0.0);
+        // In units of d_max before squaring, so that neither huge nor tiny scenes over- or
+        // underflow: in the neighbourhood the squares stay below 10.
+        let dx = (q[0] - p.x) * self.inv_d_max;
+        let dy = (q[1] - p.y) * self.inv_d_max;
+        let dz = (q[2] - p.z) * self.inv_d_max;
+        let d = (dx * dx + dy * dy + dz * dz).sqrt().max(self.d_min_rel);
+        let t = (1.0 - d).max(0.0);
         // t⁸ by squaring (not `powi`, whose rounding is unspecified across platforms).
         let t2 = t * t;
         let t4 = t2 * t2;

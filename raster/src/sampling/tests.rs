@@ -20,15 +20,15 @@ fn sphere_and_plane() -> Vec<[Vec3; 3]> {
     tris
 }
 
-/// Smallest pairwise 3-D distance, by brute force.
+/// Smallest pairwise 3-D distance, by brute force (in f64, so huge scenes do not overflow).
 fn min_distance(points: &[Vec3]) -> f32 {
-    let mut best = f32::INFINITY;
+    let mut best = f64::INFINITY;
     for i in 0..points.len() {
         for j in i + 1..points.len() {
-            best = best.min(points[i].distance(points[j]));
+            best = best.min(points[i].as_dvec3().distance(points[j].as_dvec3()));
         }
     }
-    best
+    best as f32
 }
 
 fn positions(s: &[SurfacePoint]) -> Vec<Vec3> {
@@ -242,6 +242,30 @@ fn bad_input_gives_errors_that_name_the_problem() {
             run(&[tri], SampleTarget::Spacing(s)),
             SamplingError::InvalidSpacing { .. }
         ));
+    }
+}
+
+#[test]
+fn extreme_scales_still_give_exact_counts() {
+    // Very large and very small scenes: distances over- or underflow in places; the count and
+    // validity must hold all the same, and the pattern must still be spread out.
+    for scale in [1e-18f32, 1e-6, 1e6, 1e18, 1e36] {
+        let tris: Vec<[Vec3; 3]> = sphere_and_plane()
+            .iter()
+            .map(|t| t.map(|v| v * scale))
+            .collect();
+        let s = poisson_samples(&tris, SampleTarget::Count(500), 1).unwrap();
+        assert_eq!(s.len(), 500, "scale {scale}");
+        for p in &s {
+            assert!(p.position.is_finite() && p.bary.x >= 0.0 && p.bary.y >= 0.0);
+        }
+        let d = min_distance(&positions(&s));
+        let hex = hex_spacing(total_area(&tris), 500);
+        assert!(
+            d >= 0.65 * hex,
+            "scale {scale}: min distance {} of hex spacing",
+            d / hex
+        );
     }
 }
 
