@@ -77,6 +77,32 @@ fn same_seed_gives_identical_bits_for_any_thread_count() {
     assert!(same < 30, "seeds 7 and 8 share {same} of 3000 samples");
 }
 
+/// FNV-1a over the bits of every sample.
+fn fingerprint(s: &[SurfacePoint]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for p in s {
+        let (q, b) = (p.position, p.bary);
+        for w in [q.x, q.y, q.z, b.x, b.y]
+            .map(f32::to_bits)
+            .into_iter()
+            .chain([p.triangle])
+        {
+            for byte in w.to_le_bytes() {
+                h = (h ^ byte as u64).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+    }
+    h
+}
+
+/// The exact output for one input is pinned, so that a change of platform, compiler or code
+/// that alters the samples is noticed. Changing the algorithm on purpose means updating the pin.
+#[test]
+fn output_is_pinned() {
+    let s = poisson_samples(&sphere_and_plane(), SampleTarget::Count(300), 42).unwrap();
+    assert_eq!(fingerprint(&s), 15_419_971_036_155_709_763);
+}
+
 #[test]
 fn every_sample_lies_on_its_triangle() {
     let tris = sphere_and_plane();
