@@ -1,1 +1,35 @@
 //! Rays and the bounding volume hierarchy used for shadow rays.
+//!
+//! The renderer asks one question many times: is the segment from a surface point to a light
+//! blocked? [`Bvh::build`] builds a compact binned-SAH hierarchy over the scene's world-space
+//! triangles once; [`Bvh::occluded`] answers that question (any hit, early exit) and
+//! [`Bvh::intersect`] finds the closest hit. Shadow rays start at [`offset_origin`] so they do
+//! not hit the triangle they leave.
+//!
+//! Robustness: the triangle test is watertight (Woop et al. 2013) and box tests are
+//! conservative (Ize 2013), so rays through shared edges and vertices of a closed mesh always
+//! hit it; non-finite triangles are skipped, degenerate ones never hit.
+//!
+//! | file | what |
+//! |---|---|
+//! | `aabb.rs` | boxes and the slab test |
+//! | `ray.rs` | prepared rays, the watertight triangle test, hits, origin offset |
+//! | `node.rs` | the 32-byte node |
+//! | `build.rs` | binned SAH construction |
+//! | `bvh.rs` | the BVH, its queries and `validate` |
+//! | `shapes.rs` | procedural meshes for tests and benchmarks |
+
+mod aabb;
+mod build;
+mod bvh;
+mod node;
+mod ray;
+pub mod shapes;
+
+pub use aabb::Aabb;
+pub use bvh::{Bvh, InvariantError};
+pub use node::BvhNode;
+pub use ray::{Hit, OFFSET_RELATIVE, Ray, offset_origin};
+
+#[cfg(test)]
+mod tests;

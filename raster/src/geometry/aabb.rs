@@ -1,0 +1,183 @@
+//! Axis-aligned bounding boxes: the bounds stored in BVH nodes, their surface area for the SAH,
+//! and the conservative slab test used during traversal.
+
+use glam::{Vec3, Vec3A};
+
+/// An axis-aligned box `[min, max]`. The empty box has `min = +∞` and `max = −∞`, so that
+/// growing it by any point gives that point's box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Default for Aabb {
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
+impl Aabb {
+    /// The empty box (contains nothing; the identity of [`Aabb::union`]).
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    /// The tight box around a triangle (exact: min/max of the vertex coordinates).
+    pub fn from_triangle(t: &[Vec3; 3]) -> Aabb {
+        Aabb {
+            min: t[0].min(t[1]).min(t[2]),
+            max: t[0].max(t[1]).max(t[2]),
+        }
+    }
+
+    /// True if the box contains no point.
+    pub fn is_empty(&self) -> bool {
+        !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)
+    }
+
+    /// The smallest box containing both.
+    pub fn union(&self, other: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    /// Grows the box to contain `p`.
+    pub fn grow(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    /// The centre (meaningless for the empty box). Halved before adding, so boxes near the
+    /// largest `f32` do not overflow.
+    pub fn center(&self) -> Vec3 {
+        self.min * 0.5 + self.max * 0.5
+    }
+
+    /// Half the surface area, `dx·dy + dy·dz + dz·dx` (0 for the empty box). The SAH only
+    /// compares ratios of areas, so the factor 2 is left out.
+    pub fn half_area(&self) -> f32 {
+        if self.is_empty() {
+            return 0.0;
+        }
+        let d = self.max - self.min;
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+
+    /// True if `other` lies inside `self` (the empty box lies inside every box).
+    pub fn contains(&self, other: &Aabb) -> bool {
+        other.is_empty() || (self.min.cmple(other.min).all() && other.max.cmple(self.max).all())
+    }
+
+    /// True if every coordinate is finite.
+    pub fn is_finite(&self) -> bool {
+        self.min.is_finite() && self.max.is_finite()
+    }
+}
+
+/// `1 + 2γ₃` with `γₙ = n·u / (1 − n·u)` and `u = 2⁻²⁴`: the factor by which the far slab
+/// distance is enlarged so that rounding in the slab test never rejects a box the ray touches
+/// (Ize 2013, "Robust BVH Ray Traversal", JCGT 2(2); also pbrt-v3 §3.9.2).
+const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// Direction components smaller than this in magnitude are replaced by ±`TINY_DIR` before
+/// taking the reciprocal, so the slab test never multiplies `0 · ∞` (which would give NaN for a
+/// ray starting exactly on a slab plane). The change moves the ray by `TINY_DIR · t`, far below
+/// one ulp of any coordinate a scene can use. The one case it does not treat as the exact
+/// direction would: a ray lying *in the plane* of a box of zero thickness gets the entry interval
+/// `[0, 0]` on that axis and is rejected. That box holds only triangles coplanar with the ray,
+/// which the triangle test cannot hit anyway.
+const TINY_DIR: f32 = 1e-30;
+
+/// The reciprocal direction used by [`slab_test`], finite in every component.
+pub(crate) fn safe_inverse(dir: Vec3) -> Vec3A {
+    let fix = |d: f32| {
+        if d.abs() < TINY_DIR {
+            TINY_DIR.copysign(d)
+        } else {
+            d
+        }
+    };
+    Vec3A::new(1.0 / fix(dir.x), 1.0 / fix(dir.y), 1.0 / fix(dir.z))
+}
+
+/// The entry distance of the ray `origin + t·dir` into the box `[min, max]` if the ray overlaps
+/// it for some `t ∈ [0, t_max]`, else `None`. Conservative: with `inv_dir` from
+/// [`safe_inverse`], a box containing a point the ray passes through is never rejected.
+/// SIMD (`Vec3A`): the three slabs are computed at once.
+#[inline]
+pub(crate) fn slab_test(
+    min: Vec3A,
+    max: Vec3A,
+    origin: Vec3A,
+    inv_dir: Vec3A,
+    t_max: f32,
+) -> Option<f32> {
+    let t0 = (min - origin) * inv_dir;
+    let t1 = (max - origin) * inv_dir;
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = (t0.max(t1).min_element() * ROBUST_FAR).min(t_max);
+    (near <= far).then_some(near)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The slab test on plain `Vec3`s.
+    fn slab(min: Vec3, max: Vec3, o: Vec3, inv: Vec3A, t_max: f32) -> Option<f32> {
+        slab_test(min.into(), max.into(), o.into(), inv, t_max)
+    }
+
+    #[test]
+    fn empty_box_is_union_identity() {
+        let b = Aabb::from_triangle(&[Vec3::ZERO, Vec3::X, Vec3::Y]);
+        assert_eq!(Aabb::EMPTY.union(&b), b);
+        assert!(Aabb::EMPTY.is_empty());
+        assert_eq!(Aabb::EMPTY.half_area(), 0.0);
+        assert!(b.contains(&Aabb::EMPTY));
+        assert!(!Aabb::EMPTY.contains(&b));
+    }
+
+    #[test]
+    fn half_area_of_unit_cube_is_three() {
+        let b = Aabb {
+            min: Vec3::ZERO,
+            max: Vec3::ONE,
+        };
+        assert_eq!(b.half_area(), 3.0);
+    }
+
+    #[test]
+    fn slab_handles_zero_direction_components() {
+        // Thick box, ray with zero y and z components starting exactly on the y = 0 face plane:
+        // 0·∞ must not poison the test, and the grazing ray is (conservatively) accepted.
+        let (min, max) = (Vec3::ZERO, Vec3::ONE);
+        let inv = safe_inverse(Vec3::X);
+        assert!(inv.is_finite());
+        let o = Vec3::new(-1.0, 0.0, 0.5);
+        assert_eq!(slab(min, max, o, inv, f32::INFINITY), Some(1.0));
+        // Outside the y slab: miss.
+        assert_eq!(slab(min, max, Vec3::new(-1.0, -0.1, 0.5), inv, 10.0), None);
+        // Starting inside gives entry distance 0; pointing away misses.
+        assert_eq!(slab(min, max, Vec3::splat(0.5), inv, 1.0), Some(0.0));
+        assert_eq!(slab(min, max, o, safe_inverse(-Vec3::X), 10.0), None);
+        // t_max shorter than the distance to the box.
+        assert_eq!(slab(min, max, o, inv, 0.5), None);
+        // A flat box (z extent 0) crossed perpendicularly.
+        let flat_max = Vec3::new(1.0, 1.0, 0.0);
+        let hit = slab(
+            min,
+            flat_max,
+            Vec3::new(0.5, 0.5, 2.0),
+            safe_inverse(-Vec3::Z),
+            5.0,
+        );
+        assert_eq!(hit, Some(2.0));
+    }
+}

@@ -1,0 +1,367 @@
+//! Differential tests of the BVH against a brute-force loop over every triangle, and
+//! watertightness on closed meshes.
+
+use glam::Vec3;
+
+use super::shapes::{cube, grid, icosphere};
+use super::*;
+use crate::sampling::rng::Pcg32;
+
+/// The reference: every triangle in input order, the same triangle test, the same tie rule.
+fn brute_force(tris: &[[Vec3; 3]], o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
+    let ray = Ray::new(o, d)?;
+    if t_max.is_nan() || t_max <= 0.0 {
+        return None;
+    }
+    let mut best: Option<Hit> = None;
+    for (i, t) in tris.iter().enumerate() {
+        if !t.iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        if let Some((t, u, v)) = ray.intersect_triangle(t, t_max)
+            && best.is_none_or(|b| t < b.t)
+        {
+            best = Some(Hit {
+                t,
+                triangle: i as u32,
+                u,
+                v,
+            });
+        }
+    }
+    best
+}
+
+fn random_point(rng: &mut Pcg32, lo: f32, hi: f32) -> Vec3 {
+    let mut c = || lo + (hi - lo) * rng.next_f32();
+    Vec3::new(c(), c(), c())
+}
+
+/// A soup of random triangles of widely varying size, including slivers and some exact
+/// duplicates.
+fn random_scene(rng: &mut Pcg32, n: usize) -> Vec<[Vec3; 3]> {
+    let mut tris = Vec::with_capacity(n);
+    for i in 0..n {
+        let c = random_point(rng, -10.0, 10.0);
+        let size = 0.05 + 2.0 * rng.next_f32().powi(3);
+        let t = [
+            c + random_point(rng, -size, size),
+            c + random_point(rng, -size, size),
+            c + random_point(rng, -size, size),
+        ];
+        tris.push(t);
+        if i % 97 == 0 {
+            tris.push(t);
+        }
+    }
+    tris
+}
+
+/// Checks the leaf-ordered copies against the input, on top of `validate`.
+fn check(bvh: &Bvh, input: &[[Vec3; 3]]) {
+    bvh.validate().unwrap();
+    for (slot, &id) in bvh.ids.iter().enumerate() {
+        assert_eq!(bvh.triangles[slot], input[id as usize]);
+    }
+}
+
+#[test]
+fn queries_match_brute_force_on_random_scenes() {
+    let mut rng = Pcg32::new(2024, 0);
+    for (scene, n) in [1usize, 2, 7, 50, 400, 3000].into_iter().enumerate() {
+        let tris = random_scene(&mut rng, n);
+        let bvh = Bvh::build(&tris);
+        check(&bvh, &tris);
+        let mut hits = 0;
+        for _ in 0..2_000 {
+            let o = random_point(&mut rng, -14.0, 14.0);
+            // Half the rays aim near a random triangle, so that many of them hit.
+            let d = if rng.next_f32() < 0.5 {
+                random_point(&mut rng, -1.0, 1.0)
+            } else {
+                let t = &tris[rng.next_below(tris.len() as u32) as usize];
+                (t[0] + t[1] + t[2]) / 3.0 + random_point(&mut rng, -0.3, 0.3) - o
+            };
+            // A mix of short segments and whole rays.
+            let t_max = if rng.next_f32() < 0.5 {
+                f32::INFINITY
+            } else {
+                30.0 * rng.next_f32()
+            };
+            let want = brute_force(&tris, o, d, t_max);
+            assert_eq!(bvh.occluded(o, d, t_max), want.is_some(), "scene {scene}");
+            let got = bvh.intersect(o, d, t_max);
+            match (got, want) {
+                (None, None) => {}
+                (Some(g), Some(w)) => {
+                    hits += 1;
+                    assert_eq!(g.triangle, w.triangle, "scene {scene} ray {o} {d}");
+                    assert!((g.t - w.t).abs() <= 1e-5 * w.t, "t {} vs {}", g.t, w.t);
+                    assert_eq!((g.u, g.v), (w.u, w.v));
+                }
+                _ => panic!("scene {scene} ray {o} {d}: bvh {got:?}, brute force {want:?}"),
+            }
+        }
+        // The test means something only if rays do hit.
+        if n >= 50 {
+            assert!(hits > 200, "scene {scene}: only {hits} hits");
+        }
+    }
+}
+
+#[test]
+fn rays_from_inside_a_box_of_triangles_match_brute_force() {
+    // Rays starting among the geometry: the case where near/far ordering and pruning matter.
+    let mut rng = Pcg32::new(5, 5);
+    let mut tris = icosphere(3, Vec3::ZERO, 4.0);
+    tris.extend(cube(Vec3::new(1.0, 0.5, -0.5), 1.0, 4));
+    tris.extend(grid(
+        Vec3::new(-3.0, -3.0, -2.0),
+        Vec3::X * 6.0,
+        Vec3::Y * 6.0,
+        10,
+        10,
+    ));
+    let bvh = Bvh::build(&tris);
+    check(&bvh, &tris);
+    for _ in 0..3_000 {
+        // Inside the icosphere (its inscribed radius is above 3.9).
+        let o = random_point(&mut rng, -2.2, 2.2);
+        let d = random_point(&mut rng, -1.0, 1.0);
+        let want = brute_force(&tris, o, d, f32::INFINITY);
+        let got = bvh.intersect(o, d, f32::INFINITY);
+        assert_eq!(got.map(|h| h.triangle), want.map(|h| h.triangle));
+        // Inside the closed sphere every ray hits something.
+        assert!(got.is_some() || d == Vec3::ZERO);
+        let t_half = got.map_or(1.0, |h| h.t * 0.5);
+        assert!(
+            !bvh.occluded(o, d, t_half),
+            "nothing is closer than the closest hit"
+        );
+    }
+}
+
+/// Rays from outside aimed exactly at the centre, through vertices, edge points and random
+/// points of the surface: none may slip through a closed mesh.
+fn assert_no_leaks(tris: &[[Vec3; 3]], center: Vec3, label: &str) {
+    let bvh = Bvh::build(tris);
+    check(&bvh, tris);
+    let mut rng = Pcg32::new(99, 0);
+    let mut targets = Vec::new();
+    for t in tris.iter().step_by(3) {
+        targets.push(t[0]);
+        targets.push((t[0] + t[1]) * 0.5);
+        let s = rng.next_f32();
+        targets.push(t[1] + (t[2] - t[1]) * s);
+    }
+    for target in targets {
+        // Start outside on the line through the target and the centre; aim at the centre.
+        let out = (target - center) * (1.5 + rng.next_f32() * 3.0);
+        let o = center + out;
+        let d = center - o;
+        assert!(bvh.occluded(o, d, 1.0), "{label}: ray at {target} leaked");
+        assert!(
+            bvh.intersect(o, d, 1.0).is_some(),
+            "{label}: ray at {target} leaked"
+        );
+    }
+}
+
+#[test]
+fn closed_icosphere_has_no_cracks() {
+    assert_no_leaks(
+        &icosphere(3, Vec3::new(0.3, -0.2, 0.1), 1.7),
+        Vec3::new(0.3, -0.2, 0.1),
+        "icosphere",
+    );
+}
+
+#[test]
+fn closed_cube_has_no_cracks() {
+    // Edges and corners of a cube are where three faces meet at right angles.
+    assert_no_leaks(
+        &cube(Vec3::new(0.1, 0.2, 0.3), 1.3, 5),
+        Vec3::new(0.1, 0.2, 0.3),
+        "cube",
+    );
+}
+
+#[test]
+fn empty_and_single_triangle() {
+    let empty = Bvh::build(&[]);
+    empty.validate().unwrap();
+    assert!(empty.is_empty());
+    assert!(!empty.occluded(Vec3::ZERO, Vec3::X, f32::INFINITY));
+    assert_eq!(empty.intersect(Vec3::ZERO, Vec3::X, f32::INFINITY), None);
+    assert_eq!(empty.scale(), 0.0);
+
+    let tri = [[
+        Vec3::new(2.0, -1.0, -1.0),
+        Vec3::new(2.0, 1.0, -1.0),
+        Vec3::new(2.0, 0.0, 1.0),
+    ]];
+    let one = Bvh::build(&tri);
+    check(&one, &tri);
+    assert_eq!(one.nodes().len(), 1);
+    assert!(one.occluded(Vec3::ZERO, Vec3::X, 3.0));
+    assert!(
+        !one.occluded(Vec3::ZERO, Vec3::X, 2.0),
+        "t_max is exclusive"
+    );
+    assert!(!one.occluded(Vec3::ZERO, -Vec3::X, 3.0));
+    let hit = one
+        .intersect(Vec3::ZERO, Vec3::X * 0.5, f32::INFINITY)
+        .unwrap();
+    assert_eq!(hit.t, 4.0);
+    assert_eq!(hit.triangle, 0);
+    assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.5).abs() < 1e-6);
+    assert_eq!(one.scale(), 2.0);
+}
+
+#[test]
+fn non_finite_and_degenerate_triangles_are_harmless() {
+    let good = [
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(0.0, 1.0, 1.0),
+    ];
+    let tris = [
+        [Vec3::NAN, Vec3::X, Vec3::Y],
+        good,
+        [Vec3::ZERO, Vec3::X, Vec3::new(f32::INFINITY, 0.0, 0.0)],
+        [Vec3::new(0.1, 0.1, 0.5); 3],
+        [
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(1.0, 1.0, 0.5),
+            Vec3::new(2.0, 2.0, 0.5),
+        ],
+    ];
+    let bvh = Bvh::build(&tris);
+    check(&bvh, &tris);
+    assert_eq!(bvh.skipped(), &[0, 2]);
+    assert_eq!(bvh.len(), 3);
+    assert!(bvh.bounds().is_finite());
+    let hit = bvh
+        .intersect(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 5.0)
+        .unwrap();
+    assert_eq!(hit.triangle, 1);
+    // Invalid rays and ranges are never occluded.
+    let o = Vec3::new(0.1, 0.1, 0.0);
+    for (o, d, t) in [
+        (Vec3::NAN, Vec3::Z, 5.0),
+        (o, Vec3::ZERO, 5.0),
+        (o, Vec3::new(0.0, f32::NAN, 1.0), 5.0),
+        (o, Vec3::Z, f32::NAN),
+        (o, Vec3::Z, -1.0),
+        (o, Vec3::Z, 0.0),
+    ] {
+        assert!(!bvh.occluded(o, d, t));
+        assert!(bvh.intersect(o, d, t).is_none());
+    }
+    // Only non-finite input: an empty BVH.
+    let none = Bvh::build(&[[Vec3::NAN; 3]]);
+    none.validate().unwrap();
+    assert!(none.is_empty() && none.skipped() == [0]);
+}
+
+#[test]
+fn coordinates_near_the_float_limit_do_not_break_the_tree() {
+    // Areas, centroids and SAH costs overflow to infinity here; the tree must stay valid and
+    // queries must not panic.
+    let big = f32::MAX * 0.9;
+    let mut tris = vec![
+        [
+            Vec3::splat(-big),
+            Vec3::new(big, -big, 0.0),
+            Vec3::new(0.0, big, big),
+        ],
+        [
+            Vec3::splat(big),
+            Vec3::new(-big, big, 0.0),
+            Vec3::new(0.0, -big, -big),
+        ],
+    ];
+    tris.extend(icosphere(2, Vec3::ZERO, 1.0));
+    tris.extend(icosphere(1, Vec3::splat(big * 0.5), big * 0.1));
+    let bvh = Bvh::build(&tris);
+    check(&bvh, &tris);
+    assert!(bvh.occluded(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z, 10.0));
+    let _ = bvh.intersect(Vec3::splat(-big), Vec3::ONE, f32::INFINITY);
+    let _ = bvh.occluded(Vec3::splat(big), -Vec3::ONE, f32::MAX);
+}
+
+#[test]
+fn identical_centroids_still_give_small_leaves() {
+    // 1000 copies of one triangle: no plane separates them, yet leaves stay small and the
+    // tree valid.
+    let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let tris = vec![t; 1000];
+    let bvh = Bvh::build(&tris);
+    check(&bvh, &tris);
+    let hit = bvh
+        .intersect(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 2.0)
+        .unwrap();
+    assert_eq!(hit.triangle, 0, "equal t: the lowest index wins");
+}
+
+#[test]
+fn deep_unbalanced_input_stays_within_the_stack() {
+    // Triangles at exponentially growing distances make SAH split off one at a time; the
+    // depth cap must still hold.
+    let tris: Vec<[Vec3; 3]> = (0..200)
+        .map(|i| {
+            let x = 1.2f32.powi(i);
+            [
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, 1.0, 0.0),
+                Vec3::new(x, 0.0, 1.0),
+            ]
+        })
+        .collect();
+    let bvh = Bvh::build(&tris);
+    check(&bvh, &tris);
+    for i in [0usize, 50, 199] {
+        let x = tris[i][0].x;
+        let hit = bvh.intersect(Vec3::new(x, 0.2, 0.2) - Vec3::X * 1e-3 * x, Vec3::X, 1e30);
+        assert_eq!(hit.map(|h| h.triangle), Some(i as u32));
+    }
+}
+
+#[test]
+fn build_is_deterministic() {
+    let mut rng = Pcg32::new(1, 1);
+    let tris = random_scene(&mut rng, 2000);
+    let (a, b) = (Bvh::build(&tris), Bvh::build(&tris));
+    assert_eq!(a.nodes(), b.nodes());
+    assert_eq!(a.ids, b.ids);
+}
+
+#[test]
+fn offset_shadow_rays_do_not_hit_their_own_surface() {
+    // Points on a sphere far from the origin (so absolute error is large), offset along the
+    // outward face normal: rays into the outer hemisphere must escape (the sphere is convex),
+    // rays into the sphere must be blocked.
+    let center = Vec3::new(120.0, -80.0, 45.0);
+    let tris = icosphere(4, center, 3.0);
+    let bvh = Bvh::build(&tris);
+    let mut rng = Pcg32::new(4, 4);
+    for (i, t) in tris.iter().enumerate().step_by(7) {
+        let (u, v) = (rng.next_f32() * 0.5, rng.next_f32() * 0.5);
+        let p = t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * v;
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        let o = offset_origin(p, n, bvh.scale());
+        let mut d = random_point(&mut rng, -1.0, 1.0).normalize();
+        if d.dot(n) < 0.05 {
+            d = (d + n * (0.05 - d.dot(n)) * 2.0).normalize();
+        }
+        assert!(
+            !bvh.occluded(o, d, f32::INFINITY),
+            "triangle {i} shadows itself"
+        );
+        let inward = offset_origin(p, -n, bvh.scale());
+        assert!(
+            bvh.occluded(inward, -n, f32::INFINITY),
+            "triangle {i}: inside escaped"
+        );
+    }
+}
