@@ -83,6 +83,18 @@ pub fn local_integral_unit(dipole: &UnitDipole, a: f64) -> f64 {
     total
 }
 
+/// K per channel for `profile` (at its own ℓ_u) and smoothing radius `alpha`, by a fresh
+/// quadrature: what the table approximates, for measuring it.
+pub fn exact_local_integral(profile: &Profile, alpha: f32) -> Vec3 {
+    let eta = profile.eta() as f64;
+    Vec3::from(profile.channels().map(|d| {
+        local_integral_unit(
+            &UnitDipole::new(d.albedo(), eta),
+            alpha as f64 / d.mean_free_path() as f64,
+        ) as f32
+    }))
+}
+
 /// One channel's constants.
 #[derive(Clone, Copy, Debug)]
 struct Channel {

@@ -10,7 +10,7 @@
 //! | shadow rays | [`geometry`] |
 //! | fixed-point rasterisation, visibility | [`raster`], [`camera`] |
 //! | lights and irradiance | [`lights`] |
-//! | shading through the core | [`shade`], [`render`] |
+//! | shading through the core | [`material`], [`render`] |
 //! | PNG / EXR / PLY output, image comparison | [`output`] |
 //! | the `lucent` command | [`cli`] |
 
@@ -24,5 +24,5 @@ pub mod raster;
 pub mod render;
 pub mod sampling;
 pub mod scene;
-pub mod shade;
+
 pub mod texture;

@@ -1,1 +1,357 @@
-//! Light sources and the irradiance they deliver, with shadows.
+//! Light sources and the irradiance they deliver to a surface point, with shadow rays.
+//!
+//! Units: point, spot and sphere lights have a radiant intensity I (W/sr, times `color`), so an
+//! unoccluded surface at distance d facing the light receives E = I/d²; a directional light
+//! gives E = irradiance × cos θ. A sphere light of radius r has radiance L = I/(π r²), which
+//! makes it deliver the same E as a point light of intensity I when fully visible; its soft
+//! shadows come from `samples` stratified directions in the cone it subtends, each traced.
+//!
+//! Shadow rays start off the surface (see [`offset_origin`]) and test every triangle of the
+//! scene through the BVH; a scene where nothing can occlude passes `None` and traces nothing.
+
+use glam::{Vec2, Vec3};
+
+use crate::geometry::{Bvh, offset_origin};
+use crate::sampling::rng::splitmix64;
+use crate::sampling::stratified_square;
+use crate::scene::Light;
+
+/// One light's contribution at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Incident {
+    /// Unit direction from the point towards the light (the cone axis for sphere lights).
+    pub direction: Vec3,
+    /// Irradiance from this light (cosine and visibility included).
+    pub irradiance: Vec3,
+}
+
+/// The scene's lights with what they need to cast shadows.
+#[derive(Clone, Copy, Debug)]
+pub struct Lighting<'a> {
+    lights: &'a [Light],
+    occluders: Option<&'a Bvh>,
+    /// Scene size, for the shadow-ray offset.
+    scale: f32,
+}
+
+/// 1 − small, so that a shadow ray stops just short of a light it aims at.
+const SHORTEN: f32 = 1.0 - 1e-4;
+
+impl<'a> Lighting<'a> {
+    /// Lights, the occluders (`None`: nothing can cast a shadow) and the scene's size.
+    pub fn new(lights: &'a [Light], occluders: Option<&'a Bvh>, scale: f32) -> Self {
+        Lighting {
+            lights,
+            occluders,
+            scale,
+        }
+    }
+
+    /// True if nothing can cast shadows (no shadow rays are traced).
+    pub fn unshadowed(&self) -> bool {
+        self.occluders.is_none()
+    }
+
+    fn visible(&self, p: Vec3, n: Vec3, dir: Vec3, t_max: f32) -> bool {
+        match self.occluders {
+            None => true,
+            Some(bvh) => {
+                // Leave from the side the light is on.
+                let side = if n.dot(dir) >= 0.0 { n } else { -n };
+                !bvh.occluded(offset_origin(p, side, self.scale), dir, t_max)
+            }
+        }
+    }
+
+    /// Total irradiance at `p` on a surface with unit normal `n`. `seed` decorrelates the
+    /// area-light strata between points (deterministically).
+    pub fn irradiance(&self, p: Vec3, n: Vec3, seed: u64) -> Vec3 {
+        let mut e = Vec3::ZERO;
+        self.for_each(p, n, seed, |i| e += i.irradiance);
+        e
+    }
+
+    /// Calls `f` with each light's contribution at `p` (lights that deliver nothing are
+    /// skipped).
+    pub fn for_each(&self, p: Vec3, n: Vec3, seed: u64, mut f: impl FnMut(Incident)) {
+        for (index, light) in self.lights.iter().enumerate() {
+            let incident = match *light {
+                Light::Point {
+                    position,
+                    color,
+                    intensity,
+                } => self.point(p, n, position, color * intensity, 1.0),
+                Light::Spot {
+                    position,
+                    direction,
+                    inner_angle_degrees,
+                    outer_angle_degrees,
+                    color,
+                    intensity,
+                } => {
+                    let to_p = (p - position).normalize_or_zero();
+                    let cos = to_p.dot(direction);
+                    let (ci, co) = (
+                        inner_angle_degrees.to_radians().cos(),
+                        outer_angle_degrees.to_radians().cos(),
+                    );
+                    let falloff = smoothstep(co, ci, cos);
+                    if falloff <= 0.0 {
+                        continue;
+                    }
+                    self.point(p, n, position, color * intensity, falloff)
+                }
+                Light::Directional {
+                    direction,
+                    color,
+                    irradiance,
+                } => {
+                    let dir = -direction;
+                    let cos = n.dot(dir);
+                    if cos <= 0.0 || !self.visible(p, n, dir, f32::MAX) {
+                        continue;
+                    }
+                    Some(Incident {
+                        direction: dir,
+                        irradiance: color * (irradiance * cos),
+                    })
+                }
+                Light::Sphere {
+                    center,
+                    radius,
+                    color,
+                    intensity,
+                    samples,
+                } => self.sphere(
+                    p,
+                    n,
+                    center,
+                    radius,
+                    color * intensity,
+                    samples,
+                    splitmix64(seed ^ index as u64),
+                ),
+            };
+            if let Some(i) = incident {
+                f(i);
+            }
+        }
+    }
+
+    fn point(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        position: Vec3,
+        intensity: Vec3,
+        falloff: f32,
+    ) -> Option<Incident> {
+        let to_light = position - p;
+        let d2 = to_light.length_squared();
+        if !(d2 > 0.0) {
+            return None;
+        }
+        let d = d2.sqrt();
+        let dir = to_light / d;
+        let cos = n.dot(dir);
+        if cos <= 0.0 || !self.visible(p, n, dir, d * SHORTEN) {
+            return None;
+        }
+        Some(Incident {
+            direction: dir,
+            irradiance: intensity * (falloff * cos / d2),
+        })
+    }
+
+    /// Stratified directions uniform in the cone subtended by the sphere; each is traced.
+    #[allow(clippy::too_many_arguments)]
+    fn sphere(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        center: Vec3,
+        radius: f32,
+        intensity: Vec3,
+        samples: u32,
+        seed: u64,
+    ) -> Option<Incident> {
+        let to_center = center - p;
+        let d2 = to_center.length_squared();
+        let d = d2.sqrt();
+        if !(d > radius) {
+            // Inside the light: treat as fully lit from the centre direction.
+            return self.point(p, n, center, intensity, 1.0);
+        }
+        let axis = to_center / d;
+        let sin2_max = (radius * radius / d2).min(1.0);
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        let solid_angle = std::f32::consts::TAU * (1.0 - cos_max);
+        let radiance = intensity / (std::f32::consts::PI * radius * radius);
+        let (t, b) = axis.any_orthonormal_pair();
+        let rotation = Vec2::new(
+            (seed >> 40) as f32 / (1u64 << 24) as f32,
+            ((seed >> 16) & 0xff_ffff) as f32 / (1u64 << 24) as f32,
+        );
+        let mut sum = 0.0;
+        let count = samples.max(1);
+        for u in stratified_square(count, rotation) {
+            let cos_a = 1.0 - u.x * (1.0 - cos_max);
+            let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+            let phi = std::f32::consts::TAU * u.y;
+            let dir =
+                (t * (sin_a * phi.cos()) + b * (sin_a * phi.sin()) + axis * cos_a).normalize();
+            let cos = n.dot(dir);
+            if cos <= 0.0 {
+                continue;
+            }
+            // Distance to the near side of the sphere along dir.
+            let along = d * cos_a;
+            let t_hit = along - (radius * radius - (d2 - along * along)).max(0.0).sqrt();
+            if self.visible(p, n, dir, t_hit.max(0.0) * SHORTEN) {
+                sum += cos;
+            }
+        }
+        if sum <= 0.0 {
+            return None;
+        }
+        Some(Incident {
+            direction: axis,
+            irradiance: radiance * (solid_angle * sum / count as f32),
+        })
+    }
+}
+
+fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {
+    if edge1 <= edge0 {
+        return if x >= edge1 { 1.0 } else { 0.0 };
+    }
+    let t = ((x - edge0) / (edge1 - edge0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point_light(position: Vec3, intensity: f32) -> Light {
+        Light::Point {
+            position,
+            color: Vec3::ONE,
+            intensity,
+        }
+    }
+
+    #[test]
+    fn point_light_follows_inverse_square_and_cosine() {
+        let lights = [point_light(Vec3::new(0.0, 0.0, 2.0), 8.0)];
+        let l = Lighting::new(&lights, None, 1.0);
+        let e = l.irradiance(Vec3::ZERO, Vec3::Z, 0);
+        assert!((e - Vec3::splat(2.0)).abs().max_element() < 1e-6);
+        // 60° off the normal: cos = 0.5.
+        let n = Vec3::new(3f32.sqrt() / 2.0, 0.0, 0.5);
+        assert!((l.irradiance(Vec3::ZERO, n, 0).x - 1.0).abs() < 1e-5);
+        // From behind: nothing.
+        assert_eq!(l.irradiance(Vec3::ZERO, -Vec3::Z, 0), Vec3::ZERO);
+    }
+
+    #[test]
+    fn occluder_casts_a_shadow() {
+        let lights = [point_light(Vec3::new(0.0, 0.0, 2.0), 1.0)];
+        // A triangle between the point and the light.
+        let bvh = Bvh::build(&[[
+            Vec3::new(-1.0, -1.0, 1.0),
+            Vec3::new(1.0, -1.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ]]);
+        let l = Lighting::new(&lights, Some(&bvh), 2.0);
+        assert_eq!(l.irradiance(Vec3::ZERO, Vec3::Z, 0), Vec3::ZERO);
+        assert!(l.irradiance(Vec3::new(5.0, 0.0, 0.0), Vec3::Z, 0).x > 0.0);
+    }
+
+    #[test]
+    fn unoccluded_sphere_light_equals_a_point_light() {
+        let sphere = [Light::Sphere {
+            center: Vec3::new(0.0, 0.0, 4.0),
+            radius: 0.5,
+            color: Vec3::ONE,
+            intensity: 16.0,
+            samples: 64,
+        }];
+        let point = [point_light(Vec3::new(0.0, 0.0, 4.0), 16.0)];
+        let es = Lighting::new(&sphere, None, 1.0)
+            .irradiance(Vec3::ZERO, Vec3::Z, 7)
+            .x;
+        let ep = Lighting::new(&point, None, 1.0)
+            .irradiance(Vec3::ZERO, Vec3::Z, 7)
+            .x;
+        // Exact for a facing surface: E = L π sin²θ_max = I/d².
+        assert!((es - ep).abs() / ep < 0.01, "{es} vs {ep}");
+    }
+
+    #[test]
+    fn sphere_light_gives_a_penumbra() {
+        let lights = [Light::Sphere {
+            center: Vec3::new(0.0, 0.0, 4.0),
+            radius: 1.0,
+            color: Vec3::ONE,
+            intensity: 16.0,
+            samples: 64,
+        }];
+        // A half-plane occluder x < 0 at height 2: points under its edge are half lit.
+        let h = 2.0;
+        let bvh = Bvh::build(&[
+            [
+                Vec3::new(-100.0, -100.0, h),
+                Vec3::new(0.0, -100.0, h),
+                Vec3::new(0.0, 100.0, h),
+            ],
+            [
+                Vec3::new(-100.0, -100.0, h),
+                Vec3::new(0.0, 100.0, h),
+                Vec3::new(-100.0, 100.0, h),
+            ],
+        ]);
+        let l = Lighting::new(&lights, Some(&bvh), 10.0);
+        let open = Lighting::new(&lights, None, 10.0);
+        let dark = l.irradiance(Vec3::new(-3.0, 0.0, 0.0), Vec3::Z, 1).x;
+        assert_eq!(dark, 0.0);
+        let lit = Vec3::new(3.0, 0.0, 0.0);
+        assert_eq!(
+            l.irradiance(lit, Vec3::Z, 1),
+            open.irradiance(lit, Vec3::Z, 1)
+        );
+        // Right under the edge the plane hides exactly the half of the light with x < 0.
+        let edge =
+            l.irradiance(Vec3::ZERO, Vec3::Z, 1).x / open.irradiance(Vec3::ZERO, Vec3::Z, 1).x;
+        assert!((edge - 0.5).abs() < 0.05, "edge fraction {edge}");
+        // And the penumbra is graded: a quarter of the way across it is neither.
+        let quarter = l.irradiance(Vec3::new(0.25, 0.0, 0.0), Vec3::Z, 1).x
+            / open.irradiance(Vec3::new(0.25, 0.0, 0.0), Vec3::Z, 1).x;
+        assert!(
+            quarter > 0.55 && quarter < 0.95,
+            "quarter fraction {quarter}"
+        );
+    }
+
+    #[test]
+    fn spot_and_directional_lights() {
+        let spot = [Light::Spot {
+            position: Vec3::new(0.0, 0.0, 1.0),
+            direction: -Vec3::Z,
+            inner_angle_degrees: 10.0,
+            outer_angle_degrees: 20.0,
+            color: Vec3::ONE,
+            intensity: 1.0,
+        }];
+        let l = Lighting::new(&spot, None, 1.0);
+        assert!((l.irradiance(Vec3::ZERO, Vec3::Z, 0).x - 1.0).abs() < 1e-6);
+        assert_eq!(l.irradiance(Vec3::new(1.0, 0.0, 0.0), Vec3::Z, 0).x, 0.0); // 45° off axis
+        let sun = [Light::Directional {
+            direction: Vec3::new(0.0, 0.0, -1.0),
+            color: Vec3::new(1.0, 0.5, 0.25),
+            irradiance: 2.0,
+        }];
+        let e = Lighting::new(&sun, None, 1.0).irradiance(Vec3::ZERO, Vec3::Z, 0);
+        assert!((e - Vec3::new(2.0, 1.0, 0.5)).abs().max_element() < 1e-6);
+    }
+}

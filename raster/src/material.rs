@@ -417,13 +417,14 @@ mod tests {
             .local_term(alpha, alpha / 1024.0)
             .unwrap()
             .lookup(&point);
-        // Against a table built for exactly this material.
-        let exact = LocalIntegralTable::new(&point.profile, alpha, alpha / 1024.0)
+        // Against a table built for exactly this material, looked up at the same ℓ (the ℓ
+        // interpolation is common to both; this isolates the interpolation between K_d levels).
+        let own = LocalIntegralTable::new(&point.profile, alpha, alpha / 1024.0)
             .unwrap()
-            .exact(point.profile.mean_free_path());
+            .lookup(point.profile.mean_free_path());
         assert!(
-            ((k - exact) / exact).abs().max_element() < 0.01,
-            "{k} vs {exact}"
+            ((k - own) / own).abs().max_element() < 0.002,
+            "{k} vs {own}"
         );
     }
 

@@ -1,6 +1,179 @@
-//! The `lucent` command line.
+//! The `lucent` command line: `render` (the default), `bake`, `presets`, `compare`.
+//!
+//! Exit codes: 0 success, 1 a runtime error (bad scene, missing file, …; the message names the
+//! problem), 2 a usage error (unknown flag, malformed value; printed by clap).
+
+mod commands;
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// Render translucent materials: point-based subsurface scattering (Jensen & Buhler 2002,
+/// Langlands & Mertens 2007, Neulander 2010).
+///
+/// With no arguments, renders the built-in default scene (a marble bunny with a shadow edge)
+/// to lucent.png and lucent.exr in the current directory.
+#[derive(Debug, Parser)]
+#[command(
+    name = "lucent",
+    version,
+    args_conflicts_with_subcommands = true,
+    max_term_width = 100
+)]
+pub struct Cli {
+    /// The command (default: render).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Render options, when no command is given.
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Render a scene to PNG and/or OpenEXR (the default command).
+    Render(RenderArgs),
+    /// Place and light a scene's irradiance samples and write them to a PLY point cloud, for
+    /// `render --samples-from`.
+    Bake(BakeArgs),
+    /// List the measured materials (Jensen et al. 2001) usable as `preset = "…"`.
+    Presets,
+    /// Compare two images (OpenEXR or PNG): RMSE, mean relative error, maximum error.
+    Compare(CompareArgs),
+}
+
+/// Which subsurface method to shade with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Jensen & Buhler 2002: hierarchical octree sum, no smoothing.
+    Hierarchical,
+    /// Langlands & Mertens 2007: precomputed local term + global octree sum.
+    LocalGlobal,
+    /// Neulander 2010: local term from a kernel-weighted cache query (soft shadow edges).
+    EdgeAware,
+    /// Every sample, no approximation (slow; the reference).
+    Exhaustive,
+}
+
+/// Options of `render`.
+#[derive(Debug, Args, Clone, Default)]
+pub struct RenderArgs {
+    /// Scene file (TOML, see docs/scene-format.md). Without it, the built-in default scene.
+    pub scene: Option<PathBuf>,
+    /// Write the PNG here (8-bit sRGB; overrides the scene's [output] png).
+    #[arg(short, long, value_name = "OUT.png")]
+    pub output: Option<PathBuf>,
+    /// Write the OpenEXR here (linear float; overrides the scene's [output] exr).
+    #[arg(long, value_name = "OUT.exr")]
+    pub exr: Option<PathBuf>,
+    /// Subsurface method.
+    #[arg(long, value_enum)]
+    pub method: Option<MethodArg>,
+    /// Number of irradiance samples over all translucent surfaces.
+    #[arg(long, value_name = "N", conflicts_with = "spacing")]
+    pub samples: Option<u32>,
+    /// Irradiance sample spacing in scene units (instead of a count).
+    #[arg(long, value_name = "DISTANCE")]
+    pub spacing: Option<f32>,
+    /// Image width in pixels.
+    #[arg(long, value_name = "W")]
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long, value_name = "H")]
+    pub height: Option<u32>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Anti-aliasing: AA × AA coverage samples per pixel (1–8).
+    #[arg(long, value_name = "AA")]
+    pub aa: Option<u32>,
+    /// Seed of the irradiance sample placement.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// JB02 solid-angle threshold ε (smaller = more accurate, slower).
+    #[arg(long)]
+    pub epsilon: Option<f32>,
+    /// Smoothing radius factor k of the split methods (α = k·√(mean sample area)).
+    #[arg(long, value_name = "K")]
+    pub smoothing: Option<f32>,
+    /// Exposure in stops, applied to the PNG.
+    #[arg(long, value_name = "STOPS", allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+    /// Load irradiance samples baked by `lucent bake` instead of placing and lighting new ones.
+    #[arg(long, value_name = "FILE.ply")]
+    pub samples_from: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Options of `bake`.
+#[derive(Debug, Args, Clone)]
+pub struct BakeArgs {
+    /// Scene file (TOML). Without it, the built-in default scene.
+    pub scene: Option<PathBuf>,
+    /// Where to write the samples (binary PLY).
+    #[arg(short, long, value_name = "OUT.ply", default_value = "samples.ply")]
+    pub output: PathBuf,
+    /// Number of irradiance samples.
+    #[arg(long, value_name = "N", conflicts_with = "spacing")]
+    pub samples: Option<u32>,
+    /// Irradiance sample spacing in scene units.
+    #[arg(long, value_name = "DISTANCE")]
+    pub spacing: Option<f32>,
+    /// Seed of the sample placement.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Options of `compare`.
+#[derive(Debug, Args, Clone)]
+pub struct CompareArgs {
+    /// The image under test (.exr or .png).
+    pub test: PathBuf,
+    /// The reference image (.exr or .png), same size.
+    pub reference: PathBuf,
+    /// Also write an error heat map (PNG).
+    #[arg(long, value_name = "OUT.png")]
+    pub heatmap: Option<PathBuf>,
+    /// Heat map of relative instead of absolute error.
+    #[arg(long)]
+    pub relative: bool,
+    /// Heat map on a logarithmic scale (4 decades).
+    #[arg(long)]
+    pub log: bool,
+}
 
 /// Runs the command line and returns the process exit code.
 pub fn main() -> i32 {
-    0
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let result = match cli.command {
+        None => commands::render(&cli.render),
+        Some(Command::Render(args)) => commands::render(&args),
+        Some(Command::Bake(args)) => commands::bake(&args),
+        Some(Command::Presets) => commands::presets(),
+        Some(Command::Compare(args)) => commands::compare(&args),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(message) => {
+            eprintln!("error: {message}");
+            1
+        }
+    }
 }

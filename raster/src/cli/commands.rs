@@ -1,0 +1,312 @@
+//! The commands behind the `lucent` command line. Each returns `Err(message)` for a runtime
+//! error; the message names the problem (file, key, value).
+
+use std::path::Path;
+
+use lucent_core::{Profile, presets};
+
+use super::{BakeArgs, CompareArgs, MethodArg, RenderArgs};
+use crate::output::{
+    ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, compare as compare_images, error_heatmap,
+    read_exr_rgb, read_png, write_exr, write_png,
+};
+use crate::render::{self, RenderOptions, read_baked, write_baked};
+use crate::scene::{
+    MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, Scene, SssMethod, default_scene, load_scene,
+};
+
+/// Loads the scene named on the command line, or the built-in default.
+fn load(path: Option<&Path>) -> Result<Scene, String> {
+    match path {
+        Some(p) => load_scene(p).map_err(|e| e.to_string()),
+        None => Ok(default_scene()),
+    }
+}
+
+fn check(ok: bool, flag: &str, value: impl std::fmt::Display, range: &str) -> Result<(), String> {
+    if ok {
+        Ok(())
+    } else {
+        Err(format!("{flag} {value}: must be {range}"))
+    }
+}
+
+fn density(samples: Option<u32>, spacing: Option<f32>, scene: &mut Scene) -> Result<(), String> {
+    if let Some(n) = samples {
+        check(
+            n >= 1 && n as i64 <= MAX_SAMPLES,
+            "--samples",
+            n,
+            &format!("between 1 and {MAX_SAMPLES}"),
+        )?;
+        scene.render.samples = SampleDensity::Count(n);
+    }
+    if let Some(s) = spacing {
+        check(
+            s.is_finite() && s > 0.0,
+            "--spacing",
+            s,
+            "a positive distance",
+        )?;
+        scene.render.samples = SampleDensity::Spacing(s);
+    }
+    Ok(())
+}
+
+fn threads(n: Option<usize>, scene: &mut Scene) -> Result<(), String> {
+    if let Some(n) = n {
+        check(
+            (1..=4096).contains(&n),
+            "--threads",
+            n,
+            "between 1 and 4096",
+        )?;
+        scene.render.threads = Some(n);
+    }
+    Ok(())
+}
+
+/// Applies the command-line overrides to the scene, validating each.
+fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
+    if let Some(m) = args.method {
+        scene.render.method = match m {
+            MethodArg::Hierarchical => SssMethod::Hierarchical,
+            MethodArg::LocalGlobal => SssMethod::LocalGlobal,
+            MethodArg::EdgeAware => SssMethod::EdgeAware,
+            MethodArg::Exhaustive => SssMethod::Exhaustive,
+        };
+    }
+    density(args.samples, args.spacing, scene)?;
+    threads(args.threads, scene)?;
+    for (flag, value, slot) in [
+        ("--width", args.width, &mut scene.camera.width),
+        ("--height", args.height, &mut scene.camera.height),
+    ] {
+        if let Some(v) = value {
+            check(
+                v >= 1 && v as i64 <= MAX_SIDE,
+                flag,
+                v,
+                &format!("between 1 and {MAX_SIDE} pixels"),
+            )?;
+            *slot = v;
+        }
+    }
+    let pixels = scene.camera.width as i64 * scene.camera.height as i64;
+    check(
+        pixels <= MAX_PIXELS,
+        "image size",
+        format!("{}×{}", scene.camera.width, scene.camera.height),
+        &format!("at most {MAX_PIXELS} pixels"),
+    )?;
+    if let Some(aa) = args.aa {
+        check((1..=8).contains(&aa), "--aa", aa, "between 1 and 8")?;
+        scene.render.aa = aa;
+    }
+    if let Some(seed) = args.seed {
+        scene.render.seed = seed;
+    }
+    if let Some(e) = args.epsilon {
+        check(
+            e.is_finite() && e >= 0.0,
+            "--epsilon",
+            e,
+            "a finite number ≥ 0",
+        )?;
+        scene.render.epsilon = e;
+    }
+    if let Some(k) = args.smoothing {
+        check(
+            k.is_finite() && k >= 0.0,
+            "--smoothing",
+            k,
+            "a finite number ≥ 0",
+        )?;
+        scene.render.smoothing = k;
+    }
+    if let Some(x) = args.exposure {
+        check(
+            x.is_finite() && x.abs() <= 64.0,
+            "--exposure",
+            x,
+            "between −64 and 64 stops",
+        )?;
+        scene.render.exposure = x;
+    }
+    if let Some(p) = &args.output {
+        scene.output.png = Some(p.clone());
+    }
+    if let Some(p) = &args.exr {
+        scene.output.exr = Some(p.clone());
+    }
+    Ok(())
+}
+
+fn seconds(d: std::time::Duration) -> String {
+    format!("{:.2} s", d.as_secs_f64())
+}
+
+/// `lucent render`.
+pub fn render(args: &RenderArgs) -> Result<(), String> {
+    let mut scene = load(args.scene.as_deref())?;
+    apply(args, &mut scene)?;
+    let baked = match &args.samples_from {
+        Some(path) => {
+            let groups = read_baked(path).map_err(|e| e.to_string())?;
+            Some(render::match_baked(&scene, groups).map_err(|e| e.to_string())?)
+        }
+        None => None,
+    };
+    let options = RenderOptions {
+        baked: baked.as_deref(),
+        progress: !args.quiet,
+        ..RenderOptions::default()
+    };
+    let result = render::render(&scene, &options).map_err(|e| e.to_string())?;
+
+    let mut written: Vec<String> = Vec::new();
+    if let Some(png) = &scene.output.png {
+        write_png(png, &result.image, scene.render.exposure).map_err(|e| e.to_string())?;
+        written.push(png.display().to_string());
+    }
+    if let Some(exr) = &scene.output.exr {
+        write_exr(exr, &result.image, &result.layers(&scene.output.layers))
+            .map_err(|e| e.to_string())?;
+        written.push(exr.display().to_string());
+    }
+    if !args.quiet {
+        let s = &result.stats;
+        let t = &s.timings;
+        println!(
+            "lucent: {}×{}, {} samples, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries), total {}, cache {:.1} MB, {} threads → {}",
+            scene.camera.width,
+            scene.camera.height,
+            s.samples,
+            render::core_method(scene.render.method).name(),
+            seconds(t.sampling),
+            seconds(t.irradiance),
+            seconds(t.cache),
+            seconds(t.raster),
+            seconds(t.shading),
+            s.queries,
+            seconds(t.total),
+            s.cache_bytes as f64 / 1e6,
+            s.threads,
+            written.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// `lucent bake`.
+pub fn bake(args: &BakeArgs) -> Result<(), String> {
+    let mut scene = load(args.scene.as_deref())?;
+    density(args.samples, args.spacing, &mut scene)?;
+    threads(args.threads, &mut scene)?;
+    if let Some(seed) = args.seed {
+        scene.render.seed = seed;
+    }
+    let start = std::time::Instant::now();
+    let sets = render::bake(&scene, !args.quiet).map_err(|e| e.to_string())?;
+    let names: Vec<String> = scene.objects.iter().map(|o| o.name.clone()).collect();
+    let source = scene
+        .source
+        .as_ref()
+        .map_or("built-in default scene".to_string(), |p| {
+            p.display().to_string()
+        });
+    let provenance = [
+        format!("scene {source}"),
+        format!("seed {}", scene.render.seed),
+    ];
+    write_baked(&args.output, &sets, &names, &provenance).map_err(|e| e.to_string())?;
+    if !args.quiet {
+        let n: usize = sets.iter().map(|s| s.len()).sum();
+        println!(
+            "lucent bake: {n} samples on {} objects in {} → {}",
+            sets.len(),
+            seconds(start.elapsed()),
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+/// `lucent presets`.
+pub fn presets() -> Result<(), String> {
+    println!(
+        "Measured materials of Jensen et al. 2001; coefficients per mm (scale with mm_per_unit)."
+    );
+    println!(
+        "{:<10} {:>22} {:>24} {:>5} {:>20}",
+        "name", "σ_s′ R G B", "σ_a R G B", "η", "Rd_total R G B"
+    );
+    for p in &presets::PRESETS {
+        let rd = Profile::from_preset(p, 1.0)
+            .map_err(|e| format!("preset {}: {e}", p.name))?
+            .total_reflectance();
+        let [s, a] = [p.sigma_s_prime, p.sigma_a];
+        println!(
+            "{:<10} {:>6.2} {:>6.2} {:>6.2}   {:>7.4} {:>7.4} {:>7.4} {:>5.2} {:>6.3} {:>6.3} {:>6.3}",
+            p.name, s[0], s[1], s[2], a[0], a[1], a[2], p.eta, rd.x, rd.y, rd.z
+        );
+    }
+    Ok(())
+}
+
+fn read_image(path: &Path) -> Result<RgbImage, String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "png" => read_png(path).map_err(|e| e.to_string()),
+        "exr" => read_exr_rgb(path).map_err(|e| e.to_string()),
+        _ => Err(format!(
+            "{}: unknown image type (expected .exr or .png)",
+            path.display()
+        )),
+    }
+}
+
+/// `lucent compare`.
+pub fn compare(args: &CompareArgs) -> Result<(), String> {
+    let test = read_image(&args.test)?;
+    let reference = read_image(&args.reference)?;
+    let stats = compare_images(&test, &reference, None).map_err(|e| e.to_string())?;
+    println!("pixels            {}", stats.pixels);
+    println!("RMSE              {:.6e}", stats.rmse);
+    println!("mean |error|      {:.6e}", stats.mean_abs);
+    println!("mean relative L1  {:.6e}", stats.mean_relative_l1);
+    println!(
+        "max |error|       {:.6e} at ({}, {}) channel {}",
+        stats.max_abs,
+        stats.max_abs_at.0,
+        stats.max_abs_at.1,
+        ["R", "G", "B"][stats.max_abs_channel]
+    );
+    if let Some(out) = &args.heatmap {
+        let options = HeatmapOptions {
+            metric: if args.relative {
+                ErrorMetric::Relative
+            } else {
+                ErrorMetric::Absolute
+            },
+            scale: if args.log {
+                HeatmapScale::Log { decades: 4.0 }
+            } else {
+                HeatmapScale::Linear
+            },
+            max: None,
+        };
+        let map = error_heatmap(&test, &reference, None, &options).map_err(|e| e.to_string())?;
+        map.write_png(out).map_err(|e| e.to_string())?;
+        println!(
+            "heat map          {} (white = {:.3e})",
+            out.display(),
+            map.white
+        );
+    }
+    Ok(())
+}

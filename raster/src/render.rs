@@ -1,1 +1,0 @@
-//! The render pipeline: samples → irradiance → cache → rasterise → shade.

@@ -1,0 +1,138 @@
+//! JB02's first pass: blue-noise irradiance samples over the translucent surfaces, their
+//! irradiance from the lights (with shadows), and one irradiance cache per translucent object.
+//!
+//! One Poisson-disk set covers all translucent triangles together, so every object gets the
+//! same spacing and every sample the same area (total area / N, unbiased; reference sheet §4).
+//! Caches are per object: light does not diffuse from one object into another.
+
+use glam::Vec3;
+use lucent_core::{IrradianceCache, Sample};
+use rayon::prelude::*;
+
+use super::RenderError;
+use super::prepare::Prepared;
+use crate::lights::Lighting;
+use crate::sampling::rng::splitmix64;
+use crate::sampling::{SampleTarget, poisson_samples, total_area};
+use crate::scene::SampleDensity;
+
+/// The samples on one translucent object.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ObjectSamples {
+    /// Index of the object in the scene.
+    pub object: usize,
+    /// Positions.
+    pub positions: Vec<Vec3>,
+    /// Unit shading normals.
+    pub normals: Vec<Vec3>,
+    /// Areas (scene units²).
+    pub areas: Vec<f32>,
+    /// Irradiance (filled by [`light_samples`]).
+    pub irradiance: Vec<Vec3>,
+}
+
+impl ObjectSamples {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.positions.len()
+    }
+    /// True if there are none.
+    pub fn is_empty(&self) -> bool {
+        self.positions.is_empty()
+    }
+}
+
+/// Places blue-noise samples over every translucent object (empty if there is none).
+pub fn place_samples(
+    prep: &Prepared,
+    density: SampleDensity,
+    seed: u64,
+) -> Result<Vec<ObjectSamples>, RenderError> {
+    let objects = prep.translucent_objects();
+    if objects.is_empty() {
+        return Ok(Vec::new());
+    }
+    // The translucent triangles, and where each came from.
+    let mut triangles = Vec::new();
+    let mut global = Vec::new();
+    for &o in &objects {
+        let (a, b) = (
+            prep.first_triangle[o] as usize,
+            prep.first_triangle[o + 1] as usize,
+        );
+        triangles.extend_from_slice(&prep.triangles[a..b]);
+        global.extend((a..b).map(|t| t as u32));
+    }
+    let target = match density {
+        SampleDensity::Count(n) => SampleTarget::Count(n),
+        SampleDensity::Spacing(s) => SampleTarget::Spacing(s),
+    };
+    let points = poisson_samples(&triangles, target, seed).map_err(RenderError::Sampling)?;
+    let area = (total_area(&triangles) / points.len().max(1) as f64) as f32;
+
+    let mut sets: Vec<ObjectSamples> = objects
+        .iter()
+        .map(|&object| ObjectSamples {
+            object,
+            ..Default::default()
+        })
+        .collect();
+    for p in &points {
+        let t = global[p.triangle as usize] as usize;
+        let object = prep.object_of[t] as usize;
+        let set = sets
+            .iter_mut()
+            .find(|s| s.object == object)
+            .expect("sample on a translucent object");
+        let mesh = &prep.scene.objects[object].mesh;
+        let tri = mesh.triangles[t - prep.first_triangle[object] as usize];
+        let b = [1.0 - p.bary.x - p.bary.y, p.bary.x, p.bary.y];
+        let n = (0..3).fold(Vec3::ZERO, |n, k| n + mesh.normals[tri[k] as usize] * b[k]);
+        set.positions.push(p.position);
+        set.normals.push(n.normalize_or(Vec3::Z));
+        set.areas.push(area);
+    }
+    sets.retain(|s| !s.is_empty());
+    Ok(sets)
+}
+
+/// Irradiance at every sample (in parallel; each sample's value depends only on its index).
+pub fn light_samples(
+    sets: &mut [ObjectSamples],
+    lighting: &Lighting,
+    progress: &indicatif::ProgressBar,
+) {
+    for set in sets.iter_mut() {
+        let object = set.object as u64;
+        set.irradiance = set
+            .positions
+            .par_iter()
+            .zip(&set.normals)
+            .enumerate()
+            .map(|(i, (&p, &n))| {
+                let e = lighting.irradiance(p, n, splitmix64((object << 40) ^ i as u64));
+                if i % 1024 == 0 {
+                    progress.inc(1024);
+                }
+                e
+            })
+            .collect();
+    }
+}
+
+/// Builds one cache per object's samples.
+pub fn build_caches(sets: &[ObjectSamples]) -> Result<Vec<IrradianceCache>, RenderError> {
+    sets.iter()
+        .map(|s| {
+            let samples: Vec<Sample> = (0..s.len())
+                .map(|i| Sample {
+                    position: s.positions[i],
+                    area: s.areas[i],
+                    irradiance: s.irradiance[i],
+                })
+                .collect();
+            IrradianceCache::build(&samples)
+                .map_err(|e| RenderError::Core(format!("irradiance cache: {e}")))
+        })
+        .collect()
+}

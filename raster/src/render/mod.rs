@@ -1,0 +1,403 @@
+//! The render pipeline:
+//!
+//! ```text
+//! scene ─ prepare ─┬─ samples (Poisson) ─ irradiance (shadow rays) ─ caches + K tables ─┐
+//!                  └─ rasterise (fixed point, supersampled visibility) ───────────────────┴─ shade ─ image
+//! ```
+//!
+//! Work a scene does not need is skipped: no samples, caches or tables without translucent
+//! objects; no BVH or shadow rays when nothing can occlude; no K tables for the unsplit
+//! methods, and table entries only for the ℓ the shading points ask for. Shading runs on a
+//! rayon pool over rows; every pixel depends only on its coordinates, so the image is the same
+//! for any thread count.
+
+mod baked;
+mod irradiance;
+mod prepare;
+mod shading;
+
+use std::fmt;
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use lucent_core::{Method, NoStats, QuerySettings, QueryStats};
+use rayon::prelude::*;
+
+pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
+pub use irradiance::ObjectSamples;
+pub use prepare::{Prepared, can_occlude};
+pub use shading::{ObjectCache, PixelValue, Shading};
+
+use crate::lights::Lighting;
+use crate::material::Shader;
+use crate::output::image::{LAYER_EXITANCE, LAYER_GLOBAL, LAYER_IRRADIANCE, LAYER_LOCAL};
+use crate::output::{Layer, RgbImage};
+use crate::raster::{RasterError, VisibilityBuffer};
+use crate::sampling::SamplingError;
+use crate::scene::{Scene, SssMethod};
+
+/// Why a render failed.
+#[derive(Debug)]
+pub enum RenderError {
+    /// A material's parameters are invalid.
+    Material(String),
+    /// Irradiance samples could not be placed.
+    Sampling(SamplingError),
+    /// The image buffers could not be set up.
+    Raster(RasterError),
+    /// A baked sample set does not fit the scene.
+    Baked(String),
+    /// A scene exceeds an internal limit.
+    Limit(String),
+    /// The core rejected an input (a bug if it ever happens: inputs are validated).
+    Core(String),
+    /// The thread pool could not be started.
+    Threads(String),
+}
+
+impl fmt::Display for RenderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RenderError::Material(m) => write!(f, "{m}"),
+            RenderError::Sampling(e) => write!(f, "irradiance samples: {e}"),
+            RenderError::Raster(e) => write!(f, "image: {e}"),
+            RenderError::Baked(m) => write!(f, "baked samples: {m}"),
+            RenderError::Limit(m) => write!(f, "{m}"),
+            RenderError::Core(m) => write!(f, "internal error: {m}"),
+            RenderError::Threads(m) => write!(f, "thread pool: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+/// Options beyond the scene's own settings.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderOptions<'a> {
+    /// Use these irradiance samples instead of placing and lighting new ones.
+    pub baked: Option<&'a [ObjectSamples]>,
+    /// Show progress bars on stderr (only when it is a terminal).
+    pub progress: bool,
+    /// Count traversal statistics (slightly slower).
+    pub collect_stats: bool,
+    /// Compute K by quadrature at every shading point instead of the power-of-two table.
+    pub exact_local_integral: bool,
+}
+
+/// Wall-clock time per phase.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Scene preparation (materials, BVH).
+    pub prepare: Duration,
+    /// Placing irradiance samples.
+    pub sampling: Duration,
+    /// Irradiance at the samples (shadow rays).
+    pub irradiance: Duration,
+    /// Building caches and local-integral tables.
+    pub cache: Duration,
+    /// Rasterisation.
+    pub raster: Duration,
+    /// Shading every pixel.
+    pub shading: Duration,
+    /// Everything.
+    pub total: Duration,
+}
+
+/// What a render did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Irradiance samples over all translucent objects.
+    pub samples: usize,
+    /// Bytes held by the irradiance caches.
+    pub cache_bytes: usize,
+    /// Surfaces shaded (one per pixel and visible object).
+    pub shading_points: u64,
+    /// Translucent shading points (cache queries).
+    pub queries: u64,
+    /// Traversal counters, if collected.
+    pub traversal: Option<QueryStats>,
+    /// Time per phase.
+    pub timings: Timings,
+    /// Threads used.
+    pub threads: usize,
+}
+
+/// A rendered image with its layers.
+#[derive(Clone, Debug)]
+pub struct Render {
+    /// Linear radiance.
+    pub image: RgbImage,
+    /// Per-pixel breakdown, each a full-size buffer.
+    pub pixels: Vec<PixelValue>,
+    /// What it took.
+    pub stats: RenderStats,
+}
+
+impl Render {
+    /// The EXR layers the scene asks for, in a fixed order.
+    pub fn layers(&self, wanted: &crate::scene::ExrLayers) -> Vec<Layer> {
+        let rgb = |name: &str, f: fn(&PixelValue) -> Vec3| {
+            Layer::rgb(name, self.pixels.iter().map(f).collect())
+        };
+        let mut layers = Vec::new();
+        if wanted.exitance {
+            layers.push(rgb(LAYER_EXITANCE, |p| p.exitance));
+        }
+        if wanted.local {
+            layers.push(rgb(LAYER_LOCAL, |p| p.local));
+        }
+        if wanted.global {
+            layers.push(rgb(LAYER_GLOBAL, |p| p.global));
+        }
+        if wanted.irradiance {
+            layers.push(rgb(LAYER_IRRADIANCE, |p| p.irradiance));
+        }
+        if wanted.depth {
+            layers.push(Layer::depth(self.pixels.iter().map(|p| p.depth).collect()));
+        }
+        layers
+    }
+}
+
+/// The core's method for a scene's.
+pub fn core_method(method: SssMethod) -> Method {
+    match method {
+        SssMethod::Hierarchical => Method::Hierarchical,
+        SssMethod::LocalGlobal => Method::LocalGlobal,
+        SssMethod::EdgeAware => Method::EdgeAware,
+        SssMethod::Exhaustive => Method::Exhaustive,
+    }
+}
+
+fn bar(enabled: bool, len: u64, message: &'static str) -> ProgressBar {
+    if !enabled {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:40}] {percent:>3}% {elapsed_precise}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message(message);
+    bar
+}
+
+fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, RenderError> {
+    let n = threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n.max(1))
+        .build()
+        .map_err(|e| RenderError::Threads(e.to_string()))
+}
+
+/// Places and lights the irradiance samples of a scene (what `lucent bake` writes).
+pub fn bake(scene: &Scene, progress: bool) -> Result<Vec<ObjectSamples>, RenderError> {
+    let pool = thread_pool(scene.render.threads)?;
+    pool.install(|| {
+        let prep = Prepared::new(scene)?;
+        let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
+        let mut sets = irradiance::place_samples(&prep, scene.render.samples, scene.render.seed)?;
+        let total: usize = sets.iter().map(|s| s.len()).sum();
+        let b = bar(progress, total as u64, "irradiance");
+        irradiance::light_samples(&mut sets, &lighting, &b);
+        b.finish_and_clear();
+        Ok(sets)
+    })
+}
+
+/// Renders a scene.
+pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Render, RenderError> {
+    let pool = thread_pool(scene.render.threads)?;
+    let threads = pool.current_num_threads();
+    pool.install(|| render_in_pool(scene, options, threads))
+}
+
+fn render_in_pool(
+    scene: &Scene,
+    options: &RenderOptions,
+    threads: usize,
+) -> Result<Render, RenderError> {
+    let start = Instant::now();
+    let mut timings = Timings::default();
+    let settings = &scene.render;
+    let camera = &scene.camera;
+
+    let t = Instant::now();
+    let prep = Prepared::new(scene)?;
+    let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
+    timings.prepare = t.elapsed();
+
+    // Irradiance samples: placed and lit here, or taken from a baked set.
+    let sets = match options.baked {
+        Some(baked) => {
+            baked::check_fits(&prep, baked)?;
+            baked.to_vec()
+        }
+        None => {
+            let t = Instant::now();
+            let mut sets = irradiance::place_samples(&prep, settings.samples, settings.seed)?;
+            timings.sampling = t.elapsed();
+            let t = Instant::now();
+            let total: usize = sets.iter().map(|s| s.len()).sum();
+            let b = bar(options.progress, total as u64, "irradiance");
+            irradiance::light_samples(&mut sets, &lighting, &b);
+            b.finish_and_clear();
+            timings.irradiance = t.elapsed();
+            sets
+        }
+    };
+
+    // Caches, and K tables for the split methods.
+    let t = Instant::now();
+    let method = core_method(settings.method);
+    let built = irradiance::build_caches(&sets)?;
+    let mut caches: Vec<Option<ObjectCache>> = (0..scene.objects.len()).map(|_| None).collect();
+    let mut cache_bytes = 0;
+    for (set, cache) in sets.iter().zip(built) {
+        let alpha = cache.smoothing_radius(settings.smoothing);
+        let local = match prep.shader_of(set.object) {
+            Shader::Translucent(shader) if method.is_split() && alpha > 0.0 => {
+                let ell_min = settings.ell_min.unwrap_or(alpha / 1024.0);
+                Some(shader.local_term(alpha, ell_min).map_err(|e| {
+                    RenderError::Material(format!("material '{}': {e}", shader.name))
+                })?)
+            }
+            _ => None,
+        };
+        cache_bytes += cache.memory_bytes();
+        caches[set.object] = Some(ObjectCache {
+            cache,
+            alpha,
+            local,
+        });
+    }
+    timings.cache = t.elapsed();
+
+    // Rasterise every object.
+    let t = Instant::now();
+    let (near, far) = depth_range(&prep, camera);
+    let view_proj = camera.view_projection(near, far);
+    let mut visibility = VisibilityBuffer::new(camera.width, camera.height, settings.aa)
+        .map_err(RenderError::Raster)?;
+    for (i, object) in scene.objects.iter().enumerate() {
+        visibility.rasterize_mesh(
+            view_proj,
+            &object.mesh.positions,
+            &object.mesh.triangles,
+            prep.first_triangle[i],
+        );
+    }
+    timings.raster = t.elapsed();
+
+    // Shade.
+    let t = Instant::now();
+    let shading = Shading {
+        prep: &prep,
+        lighting,
+        caches,
+        settings: QuerySettings {
+            method,
+            epsilon: settings.epsilon,
+            cull_tolerance: settings.cull_tolerance,
+            smoothing_radius: 0.0,
+        },
+        exact_local_integral: options.exact_local_integral,
+        camera,
+        view_proj,
+        visibility: &visibility,
+    };
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let b = bar(options.progress, h as u64, "shading");
+    let rows: Vec<Result<Row, RenderError>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut fragments = Vec::new();
+            let mut row = Row {
+                pixels: Vec::with_capacity(w),
+                ..Row::default()
+            };
+            for x in 0..w {
+                let value = if options.collect_stats {
+                    shading.pixel(x as u32, y as u32, &mut fragments, &mut row.stats)?
+                } else {
+                    shading.pixel(x as u32, y as u32, &mut fragments, &mut NoStats)?
+                };
+                row.points += fragments.len() as u64;
+                row.queries += fragments
+                    .iter()
+                    .filter(|f| shading.caches[f.key as usize].is_some())
+                    .count() as u64;
+                row.pixels.push(value);
+            }
+            b.inc(1);
+            Ok(row)
+        })
+        .collect();
+    b.finish_and_clear();
+    let mut pixels = Vec::with_capacity(w * h);
+    let mut traversal = QueryStats::default();
+    let (mut shading_points, mut queries) = (0, 0);
+    for row in rows {
+        let row = row?;
+        pixels.extend(row.pixels);
+        traversal.nodes_opened += row.stats.nodes_opened;
+        traversal.aggregates += row.stats.aggregates;
+        traversal.samples += row.stats.samples;
+        traversal.culled += row.stats.culled;
+        shading_points += row.points;
+        queries += row.queries;
+    }
+    traversal.queries = queries;
+    timings.shading = t.elapsed();
+    timings.total = start.elapsed();
+
+    let image = RgbImage::from_pixels(
+        camera.width,
+        camera.height,
+        pixels.iter().map(|p| p.color).collect(),
+    )
+    .map_err(|e| RenderError::Core(e.to_string()))?;
+    Ok(Render {
+        image,
+        pixels,
+        stats: RenderStats {
+            samples: sets.iter().map(|s| s.len()).sum(),
+            cache_bytes,
+            shading_points,
+            queries,
+            traversal: options.collect_stats.then_some(traversal),
+            timings,
+            threads,
+        },
+    })
+}
+
+/// One shaded row and what it cost.
+#[derive(Default)]
+struct Row {
+    pixels: Vec<PixelValue>,
+    stats: QueryStats,
+    points: u64,
+    queries: u64,
+}
+
+/// Near and far planes that enclose the scene: far beyond the farthest corner, near as far out
+/// as possible (depth precision) but never beyond the nearest geometry.
+fn depth_range(prep: &Prepared, camera: &crate::camera::Camera) -> (f32, f32) {
+    let forward = (camera.target - camera.position).normalize_or(Vec3::NEG_Z);
+    let (mut lo, mut hi) = (f32::INFINITY, 0.0_f32);
+    for v in prep.triangles.iter().flatten() {
+        let d = (*v - camera.position).dot(forward);
+        lo = lo.min(d);
+        hi = hi.max(d);
+    }
+    let far = (hi * 1.01).max(1e-3);
+    let near = if lo > 0.0 {
+        (lo * 0.5).max(far * 1e-5)
+    } else {
+        far * 1e-4
+    };
+    (near, far)
+}

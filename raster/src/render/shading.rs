@@ -1,0 +1,225 @@
+//! Shading one pixel: one shading point per visible surface (the representative sub-sample of
+//! each fragment group), weighted by its coverage.
+//!
+//! - Translucent: the material at the point, E(x) by shadow rays (split methods, highlights),
+//!   one cache query, then radiance by the §7 convention, plus an optional Fresnel-weighted
+//!   normalised Blinn–Phong highlight.
+//! - Lambert: L = albedo / π · E(x).
+
+use glam::{Mat4, Vec2, Vec3};
+use lucent_core::lanes::DefaultLanes;
+use lucent_core::table::exact_local_integral;
+use lucent_core::{IrradianceCache, QuerySettings, ShadingPoint, StatsSink, fresnel};
+
+use super::RenderError;
+use super::prepare::Prepared;
+use crate::camera::Camera;
+use crate::lights::Lighting;
+use crate::material::{LocalTerm, Shader};
+use crate::raster::{Fragment, VisibilityBuffer, perspective_barycentrics};
+use crate::sampling::rng::splitmix64;
+
+/// A translucent object's cache and smoothing.
+#[derive(Debug)]
+pub struct ObjectCache {
+    /// The irradiance cache of the object's samples.
+    pub cache: IrradianceCache,
+    /// Smoothing radius α = k √Ā.
+    pub alpha: f32,
+    /// Where K comes from (split methods only).
+    pub local: Option<LocalTerm>,
+}
+
+/// Everything a pixel's value is made of (coverage-weighted sums over its surfaces).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelValue {
+    /// Outgoing radiance.
+    pub color: Vec3,
+    /// Translucent exitance M_o.
+    pub exitance: Vec3,
+    /// Local term of the split.
+    pub local: Vec3,
+    /// Global term.
+    pub global: Vec3,
+    /// Irradiance at the shading points.
+    pub irradiance: Vec3,
+    /// Distance along the view axis to the nearest surface (+∞ for none).
+    pub depth: f32,
+}
+
+impl Default for PixelValue {
+    fn default() -> Self {
+        PixelValue {
+            color: Vec3::ZERO,
+            exitance: Vec3::ZERO,
+            local: Vec3::ZERO,
+            global: Vec3::ZERO,
+            irradiance: Vec3::ZERO,
+            depth: f32::INFINITY,
+        }
+    }
+}
+
+/// The read-only state every pixel is shaded from.
+pub struct Shading<'a> {
+    /// The prepared scene.
+    pub prep: &'a Prepared<'a>,
+    /// Lights and occluders.
+    pub lighting: Lighting<'a>,
+    /// Per object: its cache, if translucent.
+    pub caches: Vec<Option<ObjectCache>>,
+    /// Method, ε and cull tolerance (α is per object).
+    pub settings: QuerySettings,
+    /// Use a fresh quadrature for K at every point instead of the table (for measuring the
+    /// table's error).
+    pub exact_local_integral: bool,
+    /// The camera.
+    pub camera: &'a Camera,
+    /// World → clip.
+    pub view_proj: Mat4,
+    /// The rasterised visibility.
+    pub visibility: &'a VisibilityBuffer,
+}
+
+impl Shading<'_> {
+    /// Shades pixel (x, y); `fragments` is scratch space.
+    pub fn pixel<S: StatsSink>(
+        &self,
+        x: u32,
+        y: u32,
+        fragments: &mut Vec<Fragment>,
+        stats: &mut S,
+    ) -> Result<PixelValue, RenderError> {
+        let object_of = &self.prep.object_of;
+        self.visibility
+            .resolve(x, y, |t| object_of[t as usize], fragments);
+        let mut value = PixelValue::default();
+        let aa = self.visibility.aa();
+        let per_sample = 1.0 / (aa * aa) as f32;
+        let forward = (self.camera.target - self.camera.position).normalize();
+        let pixel_index = y as u64 * self.camera.width as u64 + x as u64;
+        for (k, fragment) in fragments.iter().enumerate() {
+            let seed = splitmix64(pixel_index * 16 + k as u64);
+            let s = self.surface(fragment, seed, stats)?;
+            let w = fragment.coverage as f32 * per_sample;
+            value.color += s.color * w;
+            value.exitance += s.exitance * w;
+            value.local += s.local * w;
+            value.global += s.global * w;
+            value.irradiance += s.irradiance * w;
+            if k == 0 {
+                value.depth = (s.position - self.camera.position).dot(forward);
+            }
+        }
+        Ok(value)
+    }
+
+    fn surface<S: StatsSink>(
+        &self,
+        fragment: &Fragment,
+        seed: u64,
+        stats: &mut S,
+    ) -> Result<Surface, RenderError> {
+        let prep = self.prep;
+        let object = fragment.key as usize;
+        let mesh = &prep.scene.objects[object].mesh;
+        let tri = mesh.triangles[fragment.triangle as usize - prep.first_triangle[object] as usize];
+        let v = tri.map(|i| mesh.positions[i as usize]);
+        let clip = v.map(|p| self.view_proj * p.extend(1.0));
+        let b =
+            perspective_barycentrics(clip, fragment.sample, self.camera.width, self.camera.height)
+                .unwrap_or(Vec3::splat(1.0 / 3.0));
+        let position = v[0] * b.x + v[1] * b.y + v[2] * b.z;
+        let mut normal = (0..3)
+            .fold(Vec3::ZERO, |n, k| n + mesh.normals[tri[k] as usize] * b[k])
+            .normalize_or(Vec3::Z);
+        let uv = mesh.uvs.as_ref().map_or(Vec2::ZERO, |uv| {
+            (0..3).fold(Vec2::ZERO, |t, k| t + uv[tri[k] as usize] * b[k])
+        });
+        let view = (self.camera.position - position).normalize_or(Vec3::Z);
+        let geometric = (v[1] - v[0]).cross(v[2] - v[0]);
+        if geometric.dot(view) < 0.0 {
+            // Seen from behind (open meshes): shade the side the camera sees.
+            normal = -normal;
+        }
+        let cos_out = normal.dot(view).clamp(0.0, 1.0);
+        let mut out = Surface {
+            position,
+            ..Surface::default()
+        };
+        match prep.shader_of(object) {
+            Shader::Lambert { albedo } => {
+                let e = self.lighting.irradiance(position, normal, seed);
+                out.irradiance = e;
+                out.color = *albedo * e * std::f32::consts::FRAC_1_PI;
+            }
+            Shader::Translucent(shader) => {
+                let oc = self.caches[object].as_ref().ok_or_else(|| {
+                    RenderError::Core(format!("no irradiance cache for object {object}"))
+                })?;
+                let point = shader.at(uv).map_err(|e| {
+                    RenderError::Material(format!("material '{}': {e}", shader.name))
+                })?;
+                let method = self.settings.method;
+                let mut e = Vec3::ZERO;
+                let mut highlight = Vec3::ZERO;
+                if method.is_split() || shader.specular.is_some() {
+                    self.lighting.for_each(position, normal, seed, |incident| {
+                        e += incident.irradiance;
+                        if let Some(spec) = shader.specular {
+                            let h = (incident.direction + view).normalize_or_zero();
+                            let n_h = normal.dot(h).max(0.0);
+                            let f = fresnel::reflectance(
+                                point.profile.eta() as f64,
+                                view.dot(h).clamp(0.0, 1.0) as f64,
+                            ) as f32;
+                            let lobe = (spec.exponent + 8.0) / (8.0 * std::f32::consts::PI)
+                                * n_h.powf(spec.exponent);
+                            highlight += incident.irradiance * (spec.strength * f * lobe);
+                        }
+                    });
+                }
+                let k = match &oc.local {
+                    Some(_) if self.exact_local_integral => {
+                        exact_local_integral(&point.profile, oc.alpha)
+                    }
+                    Some(term) => term.lookup(&point),
+                    None => Vec3::ZERO,
+                };
+                let settings = QuerySettings {
+                    smoothing_radius: oc.alpha,
+                    ..self.settings
+                };
+                let m = oc
+                    .cache
+                    .query_with::<DefaultLanes, S>(
+                        &point.profile,
+                        &ShadingPoint {
+                            position,
+                            irradiance: e,
+                        },
+                        k,
+                        &settings,
+                        stats,
+                    )
+                    .map_err(|err| RenderError::Core(format!("query at {position}: {err}")))?;
+                out.exitance = m.total;
+                out.local = m.local;
+                out.global = m.global;
+                out.irradiance = e;
+                out.color = point.profile.radiance(m.total, cos_out) + highlight;
+            }
+        }
+        Ok(out)
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Surface {
+    position: Vec3,
+    color: Vec3,
+    exitance: Vec3,
+    local: Vec3,
+    global: Vec3,
+    irradiance: Vec3,
+}

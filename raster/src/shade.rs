@@ -1,1 +1,0 @@
-//! Shading a visible surface point: translucent through the core, opaque Lambert.
