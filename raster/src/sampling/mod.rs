@@ -22,6 +22,7 @@ mod grid;
 mod maxtree;
 mod poisson;
 pub mod rng;
+mod strata;
 mod stratified;
 mod surface;
 

@@ -2,7 +2,10 @@
 //! (Yuksel 2015, "Sample Elimination for Generating Poisson Disk Sample Sets", Computer
 //! Graphics Forum 34(2)).
 //!
-//! 1. Draw `M = 5N` area-uniform candidates (the paper's recommended ratio).
+//! 1. Draw `M = 5N` area-uniform candidates (the paper's recommended ratio), stratified along
+//!    a space-filling curve so that their density is nearly exact at every scale (see
+//!    `strata.rs`: with independent uniform candidates the output kept ~1–3% low-frequency
+//!    density noise, which became per-pixel error).
 //! 2. Give each candidate the weight `w_i = Σ_j (1 − d̂_ij / d_max)^α` over the candidates `j`
 //!    closer than `d_max = 2·r_max`, with `α = 8` (the paper's value) and `r_max` the disk
 //!    radius of hexagonal packing at `N` points: `d_max` = [`hex_spacing`]`(A, N)`. Distances
@@ -34,6 +37,7 @@ use super::error::SamplingError;
 use super::grid::NeighbourGrid;
 use super::maxtree::MaxTree;
 use super::rng::{Pcg32, splitmix64};
+use super::strata::Strata;
 use super::surface::{AreaDistribution, SampleTarget, SurfacePoint, hex_spacing};
 
 /// Candidates per output sample (Yuksel 2015 §5: quality saturates around 5).
@@ -47,6 +51,10 @@ fn weight_limit_power() -> f64 {
 }
 /// Weight limiting factor β.
 const BETA: f64 = 0.65;
+/// Samples each patch of consecutive candidates must keep (see the quotas in step 3).
+const GROUP_SAMPLES: usize = 64;
+/// Candidates per quota group.
+const GROUP_CANDIDATES: usize = CANDIDATE_RATIO * GROUP_SAMPLES;
 /// Candidates drawn from one random stream.
 const BLOCK: usize = 4096;
 
@@ -64,6 +72,7 @@ pub fn poisson_samples(
     let dist = AreaDistribution::new(triangles)?;
     let n = target.resolve(dist.total())? as usize;
     let m = n * CANDIDATE_RATIO;
+    let strata = Strata::new(triangles, dist.total(), m);
 
     // 1. Candidates.
     let mut candidates = vec![
@@ -80,8 +89,8 @@ pub fn poisson_samples(
         .for_each(|(block, chunk)| {
             let stream = block as u64;
             let mut rng = Pcg32::new(splitmix64(seed ^ splitmix64(stream)), stream);
-            for c in chunk {
-                *c = dist.sample(triangles, &mut rng);
+            for (k, c) in chunk.iter_mut().enumerate() {
+                *c = strata.candidate(triangles, block * BLOCK + k, m, &mut rng);
             }
         });
 
@@ -113,6 +122,27 @@ pub fn poisson_samples(
 
     // 3. Elimination. A removed candidate's weight becomes −∞, which stays −∞ under the
     // unconditional updates below and is never the maximum while live candidates remain.
+    //
+    // Quotas: candidates are generated along the Morton curve, so each run of
+    // `CANDIDATE_RATIO · GROUP_SAMPLES` consecutive candidates is a compact patch of surface,
+    // and it must keep exactly `GROUP_SAMPLES` samples. Once a group is down to its quota its
+    // survivors are locked (weight `f32::MIN`: never the maximum, still repelling their
+    // neighbours, kept by the final filter). Without quotas the elimination itself left
+    // low-frequency density noise (how many disks fit a patch varies), which every method then
+    // shows as per-pixel error. Measured on a 40 × 40 plane with 60k samples, std of the counts
+    // in 4×4 / 8×8 boxes: 1.21% / 0.63% without quotas, 0.78% / 0.37% with groups of 64; groups
+    // of 16 cut it further but locked close pairs (minimum distance 0.09 of the hexagonal
+    // spacing), groups of 64 keep it at 0.67.
+    let group_of = |candidate: u32| candidate as usize / GROUP_CANDIDATES;
+    let groups = m.div_ceil(GROUP_CANDIDATES);
+    let mut live = vec![0u32; groups];
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); groups];
+    for (sorted, &c) in order.iter().enumerate() {
+        live[group_of(c)] += 1;
+        members[group_of(c)].push(sorted as u32);
+    }
+    // m = CANDIDATE_RATIO · n exactly, so every group keeps 1/CANDIDATE_RATIO of its candidates.
+    let quota: Vec<u32> = live.iter().map(|&l| l / CANDIDATE_RATIO as u32).collect();
     let weight_of = |q: &[f32; 4]| q[3];
     let mut tree = MaxTree::new(&points.xyzw, weight_of);
     for _ in 0..m - n {
@@ -123,6 +153,17 @@ pub fn poisson_samples(
             let (a, b) = (a as usize, b as usize);
             kernel.subtract(p, &mut points.xyzw[a..b]);
             tree.update(&points.xyzw, weight_of, a, b);
+        }
+        let g = group_of(order[i as usize]);
+        live[g] -= 1;
+        if live[g] == quota[g] {
+            for &j in &members[g] {
+                let j = j as usize;
+                if points.xyzw[j][3] != f32::NEG_INFINITY {
+                    points.xyzw[j][3] = f32::MIN;
+                    tree.update(&points.xyzw, weight_of, j, j + 1);
+                }
+            }
         }
     }
     Ok(order

@@ -91,7 +91,7 @@ mod tests {
             Some(std::path::Path::new("lucent.exr"))
         );
         assert!(s.source.is_none());
-        assert_eq!(s.lights.len(), 1);
+        assert_eq!(s.lights.len(), 2); // the key (casting the plate's shadow) and a dim fill
         let bunny = s.objects.iter().find(|o| o.name == "bunny").expect("bunny");
         assert_eq!(bunny.mesh.triangles.len(), 3674);
         match &s.materials[bunny.material] {
@@ -206,8 +206,9 @@ mod tests {
         let total = (lit.len() + shadowed.len()) as f32;
         assert!(total > 300.0, "only {total} candidate vertices");
         let fraction = shadowed.len() as f32 / total;
+        // Face and ears lit, the back and haunch in shadow: a quarter to a half shadowed.
         assert!(
-            (0.3..0.7).contains(&fraction),
+            (0.2..0.5).contains(&fraction),
             "{} lit, {} shadowed",
             lit.len(),
             shadowed.len()
