@@ -88,10 +88,10 @@ fn setup() -> &'static Setup {
     })
 }
 
-fn settings(method: Method, alpha: f32) -> QuerySettings {
+fn settings_eps(method: Method, alpha: f32, epsilon: f32) -> QuerySettings {
     QuerySettings {
         method,
-        epsilon: 0.05,
+        epsilon,
         cull_tolerance: 1e-4,
         smoothing_radius: alpha,
     }
@@ -107,16 +107,31 @@ fn main() {
         s.cache.memory_bytes(),
         s.cache.memory_bytes() as f64 / s.cache.len() as f64
     );
-    for method in [Method::Hierarchical, Method::LocalGlobal, Method::EdgeAware] {
+    for (method, epsilon) in [
+        (Method::Hierarchical, 0.05),
+        (Method::LocalGlobal, 0.05),
+        (Method::EdgeAware, 0.05),
+        (Method::Hierarchical, 0.4),
+        (Method::LocalGlobal, 0.4),
+        (Method::EdgeAware, 0.4),
+        (Method::Hierarchical, 2.0),
+        (Method::EdgeAware, 2.0),
+    ] {
         let mut stats = QueryStats::default();
         for p in &s.points {
             s.cache
-                .query_with_stats(&s.profile, p, s.k, &settings(method, s.alpha), &mut stats)
+                .query_with_stats(
+                    &s.profile,
+                    p,
+                    s.k,
+                    &settings_eps(method, s.alpha, epsilon),
+                    &mut stats,
+                )
                 .unwrap();
         }
         let q = stats.queries as f64;
         println!(
-            "{:>13}: {:.1} nodes opened, {:.1} aggregates, {:.1} samples, {:.1} culled, {:.1} profile evaluations per query",
+            "{:>13} ε {epsilon:<4}: {:.1} nodes opened, {:.1} aggregates, {:.1} samples, {:.1} culled, {:.1} profile evaluations per query",
             method.name(),
             stats.nodes_opened as f64 / q,
             stats.aggregates as f64 / q,
@@ -165,9 +180,9 @@ fn build(b: Bencher, n: usize) {
         .bench(|| IrradianceCache::build(black_box(&input)).unwrap());
 }
 
-fn run_queries<L: Lanes>(b: Bencher, method: Method) {
+fn run_queries<L: Lanes>(b: Bencher, method: Method, epsilon: f32) {
     let s = setup();
-    let settings = settings(method, s.alpha);
+    let settings = settings_eps(method, s.alpha, epsilon);
     b.counter(divan::counter::ItemsCount::new(QUERIES))
         .bench(|| {
             let mut acc = Vec3::ZERO;
@@ -182,22 +197,24 @@ fn run_queries<L: Lanes>(b: Bencher, method: Method) {
         });
 }
 
-/// Queries per second per method at 23k samples (ε 0.05, cull tolerance 1e-4, k 1.5).
-#[divan::bench(types = [ScalarLanes, SimdLanes])]
-fn query_hierarchical<L: Lanes>(b: Bencher) {
-    run_queries::<L>(b, Method::Hierarchical);
+/// Queries per second per method at 23k samples (cull tolerance 1e-4, k 1.5), at ε from 0.05
+/// (pbrt-v2's default) to 2 (about the 0.6% image error of the C++ reference of issue 4 with
+/// lucent's second-order aggregates).
+#[divan::bench(types = [ScalarLanes, SimdLanes], args = [0.05, 0.4, 1.0, 2.0])]
+fn query_hierarchical<L: Lanes>(b: Bencher, epsilon: f32) {
+    run_queries::<L>(b, Method::Hierarchical, epsilon);
 }
 
 /// See [`query_hierarchical`].
-#[divan::bench(types = [ScalarLanes, SimdLanes])]
-fn query_local_global<L: Lanes>(b: Bencher) {
-    run_queries::<L>(b, Method::LocalGlobal);
+#[divan::bench(types = [ScalarLanes, SimdLanes], args = [0.05, 0.4, 1.0, 2.0])]
+fn query_local_global<L: Lanes>(b: Bencher, epsilon: f32) {
+    run_queries::<L>(b, Method::LocalGlobal, epsilon);
 }
 
 /// See [`query_hierarchical`].
-#[divan::bench(types = [ScalarLanes, SimdLanes])]
-fn query_edge_aware<L: Lanes>(b: Bencher) {
-    run_queries::<L>(b, Method::EdgeAware);
+#[divan::bench(types = [ScalarLanes, SimdLanes], args = [0.05, 0.4, 1.0, 2.0])]
+fn query_edge_aware<L: Lanes>(b: Bencher, epsilon: f32) {
+    run_queries::<L>(b, Method::EdgeAware, epsilon);
 }
 
 /// The exhaustive sum over all 23k samples (per query).

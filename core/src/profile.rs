@@ -211,6 +211,16 @@ impl Profile {
             self.channels[2].rd_lanes(r2),
         ]
     }
+    /// Second-order corrected node aggregate per channel (see
+    /// [`Dipole::rd_lanes_corrected`]).
+    #[inline(always)]
+    pub fn rd_lanes_corrected<L: Lanes>(&self, r2: L, q: L, trace: L) -> [L; 3] {
+        [
+            self.channels[0].rd_lanes_corrected(r2, q, trace),
+            self.channels[1].rd_lanes_corrected(r2, q, trace),
+            self.channels[2].rd_lanes_corrected(r2, q, trace),
+        ]
+    }
     /// Rd(0) per channel.
     pub fn rd_zero(&self) -> Vec3 {
         Vec3::from(self.channels.map(|d| d.rd_zero()))

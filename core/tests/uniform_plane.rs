@@ -55,11 +55,14 @@ fn every_method_reproduces_e_times_rd_total_on_a_lit_plane() {
             position: x,
             irradiance: e,
         };
+        // The issue requires 1% (every method) and 0.5% (the split methods). Measured: 0.0001%
+        // exhaustive, 0.0034% hierarchical (second-order aggregates; 0.39% with JB02's plain
+        // ones), 0.047% local-global and edge-aware. The bounds catch regressions.
         for (method, tolerance) in [
-            (Method::Exhaustive, 0.01),
-            (Method::Hierarchical, 0.01),
-            (Method::LocalGlobal, 0.005),
-            (Method::EdgeAware, 0.005),
+            (Method::Exhaustive, 0.0001),
+            (Method::Hierarchical, 0.0002),
+            (Method::LocalGlobal, 0.002),
+            (Method::EdgeAware, 0.002),
         ] {
             for k in [1.0, 3.0] {
                 let alpha = cache.smoothing_radius(k);

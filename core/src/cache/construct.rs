@@ -7,7 +7,7 @@
 
 use alloc::vec::Vec;
 
-use glam::{DVec3, Vec3};
+use glam::{DMat3, DVec3, Vec3};
 
 use super::{
     COUNT_MASK, IrradianceCache, LEAF_BIT, LEAF_CAPACITY, MAX_SAMPLES, Nodes, Sample, Samples,
@@ -170,7 +170,7 @@ impl IrradianceCache {
         }
 
         let depth = pending.iter().map(|p| p.depth as usize).max().unwrap_or(0);
-        let nodes = aggregate(&pending, &samples);
+        let (nodes, bounds) = aggregate(&pending, &samples);
         let mean_area = if n > 0 {
             (nodes.area[0] as f64 / n as f64) as f32
         } else {
@@ -184,6 +184,7 @@ impl IrradianceCache {
             grid,
             mean_area,
             depth,
+            bounds,
         };
         cache.shrink();
         Ok(cache)
@@ -204,12 +205,6 @@ impl IrradianceCache {
         }
         let n = &mut self.nodes;
         for c in [
-            &mut n.min_x,
-            &mut n.min_y,
-            &mut n.min_z,
-            &mut n.max_x,
-            &mut n.max_y,
-            &mut n.max_z,
             &mut n.area,
             &mut n.flux_r,
             &mut n.flux_g,
@@ -217,6 +212,13 @@ impl IrradianceCache {
             &mut n.centroid_x,
             &mut n.centroid_y,
             &mut n.centroid_z,
+            &mut n.radius,
+            &mut n.cov_xx,
+            &mut n.cov_yy,
+            &mut n.cov_zz,
+            &mut n.cov_xy,
+            &mut n.cov_xz,
+            &mut n.cov_yz,
         ] {
             c.shrink_to_fit();
         }
@@ -257,6 +259,9 @@ struct Sums {
     weight: f64,
     /// Σ A p (the fallback centroid for nodes without flux).
     area_weighted: DVec3,
+    /// Σ p and the sample count (the centroid of nodes with neither flux nor area).
+    position_sum: DVec3,
+    count: f64,
 }
 
 impl Sums {
@@ -275,6 +280,32 @@ impl Sums {
         self.weighted += o.weighted;
         self.weight += o.weight;
         self.area_weighted += o.area_weighted;
+        self.position_sum += o.position_sum;
+        self.count += o.count;
+    }
+    /// The weight of one sample under this node's weighting (flux, else area, else uniform).
+    fn sample_weight(&self, flux: DVec3, area: f64) -> f64 {
+        if self.weight > 0.0 {
+            flux.x + flux.y + flux.z
+        } else if self.area > 0.0 {
+            area
+        } else {
+            1.0
+        }
+    }
+    /// The total weight of a child under this node's weighting.
+    fn child_weight(&self, child: &Sums) -> f64 {
+        if self.weight > 0.0 {
+            child.weight
+        } else if self.area > 0.0 {
+            child.area
+        } else {
+            child.count
+        }
+    }
+    /// This node's total weight under its own weighting.
+    fn total_weight(&self) -> f64 {
+        self.child_weight(self)
     }
     fn centroid(&self) -> DVec3 {
         let c = if self.weight > 0.0 {
@@ -282,7 +313,7 @@ impl Sums {
         } else if self.area > 0.0 {
             self.area_weighted / self.area
         } else {
-            (self.lo + self.hi) * 0.5
+            self.position_sum / self.count.max(1.0)
         };
         c.clamp(self.lo, self.hi)
     }
@@ -290,7 +321,8 @@ impl Sums {
 
 /// Aggregates bottom-up (children have larger indices than parents, so a reverse sweep sees
 /// every child before its parent) and writes the node columns.
-fn aggregate(pending: &[Pending], s: &Samples) -> Nodes {
+#[allow(clippy::type_complexity)]
+fn aggregate(pending: &[Pending], s: &Samples) -> (Nodes, Option<(Vec3, Vec3)>) {
     let count = pending.len();
     let mut sums = alloc::vec![Sums::empty(); count];
     for i in (0..count).rev() {
@@ -310,6 +342,8 @@ fn aggregate(pending: &[Pending], s: &Samples) -> Nodes {
                     weighted: pos * w,
                     weight: w,
                     area_weighted: pos * area,
+                    position_sum: pos,
+                    count: 1.0,
                 });
             }
         } else {
@@ -320,20 +354,18 @@ fn aggregate(pending: &[Pending], s: &Samples) -> Nodes {
         sums[i] = acc;
     }
 
-    let padded = count + LANES;
-    let column = |f: &dyn Fn(&Sums) -> f64| {
-        let mut c = Vec::with_capacity(padded);
-        c.extend(sums.iter().map(|s| f(s) as f32));
-        c.resize(padded, 0.0);
-        c
-    };
     let centroids: Vec<DVec3> = sums.iter().map(Sums::centroid).collect();
-    let centroid_column = |axis: usize| {
+    let covariances = covariances(pending, s, &sums, &centroids);
+    let radii = radii(pending, s, &centroids);
+
+    let padded = count + LANES;
+    let column = |values: &mut dyn Iterator<Item = f32>| {
         let mut c = Vec::with_capacity(padded);
-        c.extend(centroids.iter().map(|v| v[axis] as f32));
+        c.extend(values);
         c.resize(padded, 0.0);
         c
     };
+    let cov = |a: usize, b: usize| column(&mut covariances.iter().map(|m| m.col(a)[b] as f32));
     let mut first = Vec::with_capacity(padded);
     let mut info = Vec::with_capacity(padded);
     for p in pending {
@@ -342,21 +374,76 @@ fn aggregate(pending: &[Pending], s: &Samples) -> Nodes {
     }
     first.resize(padded, 0);
     info.resize(padded, 0);
-    Nodes {
-        min_x: column(&|s| s.lo.x),
-        min_y: column(&|s| s.lo.y),
-        min_z: column(&|s| s.lo.z),
-        max_x: column(&|s| s.hi.x),
-        max_y: column(&|s| s.hi.y),
-        max_z: column(&|s| s.hi.z),
-        area: column(&|s| s.area),
-        flux_r: column(&|s| s.flux.x),
-        flux_g: column(&|s| s.flux.y),
-        flux_b: column(&|s| s.flux.z),
-        centroid_x: centroid_column(0),
-        centroid_y: centroid_column(1),
-        centroid_z: centroid_column(2),
+    let root_bounds = sums.first().map(|r| (r.lo.as_vec3(), r.hi.as_vec3()));
+    let nodes = Nodes {
+        area: column(&mut sums.iter().map(|s| s.area as f32)),
+        flux_r: column(&mut sums.iter().map(|s| s.flux.x as f32)),
+        flux_g: column(&mut sums.iter().map(|s| s.flux.y as f32)),
+        flux_b: column(&mut sums.iter().map(|s| s.flux.z as f32)),
+        centroid_x: column(&mut centroids.iter().map(|c| c.x as f32)),
+        centroid_y: column(&mut centroids.iter().map(|c| c.y as f32)),
+        centroid_z: column(&mut centroids.iter().map(|c| c.z as f32)),
+        radius: column(&mut radii.into_iter()),
+        cov_xx: cov(0, 0),
+        cov_yy: cov(1, 1),
+        cov_zz: cov(2, 2),
+        cov_xy: cov(0, 1),
+        cov_xz: cov(0, 2),
+        cov_yz: cov(1, 2),
         first,
         info,
+    };
+    (nodes, root_bounds)
+}
+
+/// Per node, the weighted covariance of its samples about its centroid (the same weights as
+/// the centroid), bottom-up by the parallel-axis theorem:
+/// C = Σ_children W_c (C_c + (P_c − P)(P_c − P)ᵀ) / W.
+fn covariances(pending: &[Pending], s: &Samples, sums: &[Sums], centroids: &[DVec3]) -> Vec<DMat3> {
+    let outer = |d: DVec3| DMat3::from_cols(d * d.x, d * d.y, d * d.z);
+    let mut cov = alloc::vec![DMat3::ZERO; pending.len()];
+    for i in (0..pending.len()).rev() {
+        let p = pending[i];
+        let node = &sums[i];
+        let centre = centroids[i];
+        let mut acc = DMat3::ZERO;
+        if p.leaf {
+            for j in p.first as usize..(p.first + p.count) as usize {
+                let pos = DVec3::new(s.pos_x[j] as f64, s.pos_y[j] as f64, s.pos_z[j] as f64);
+                let flux = DVec3::new(s.flux_r[j] as f64, s.flux_g[j] as f64, s.flux_b[j] as f64);
+                acc += outer(pos - centre) * node.sample_weight(flux, s.area[j] as f64);
+            }
+        } else {
+            for c in p.first as usize..(p.first + p.count) as usize {
+                acc += (cov[c] + outer(centroids[c] - centre)) * node.child_weight(&sums[c]);
+            }
+        }
+        cov[i] = acc * (1.0 / node.total_weight().max(f64::MIN_POSITIVE));
     }
+    cov
+}
+
+/// Per node, the radius of the sphere about its centroid that holds all its samples, exact
+/// (every sample visited once per ancestor), measured about the centroid as stored (f32) and
+/// rounded up.
+fn radii(pending: &[Pending], s: &Samples, centroids: &[DVec3]) -> Vec<f32> {
+    pending
+        .iter()
+        .zip(centroids)
+        .map(|(p, &centre)| {
+            let centre = centre.as_vec3().as_dvec3();
+            let mut r2 = 0.0f64;
+            for j in p.start as usize..p.end as usize {
+                let pos = DVec3::new(s.pos_x[j] as f64, s.pos_y[j] as f64, s.pos_z[j] as f64);
+                r2 = r2.max((pos - centre).length_squared());
+            }
+            let r = libm::sqrt(r2);
+            let rounded = r as f32;
+            if (rounded as f64) < r {
+                rounded.next_up()
+            } else {
+                rounded
+            }
+        })
+        .collect()
 }

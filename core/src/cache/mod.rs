@@ -15,19 +15,26 @@
 //!   flux_r flux_g flux_b           flux = E·A (irradiance times area)
 //!
 //! nodes (breadth-first)           n0 | n1 n2 n3 n4 | n5 n6 … | … | 8 padding nodes
-//!   min_x min_y min_z             └root┘└children of n0┘
-//!   max_x max_y max_z             tight bounds of the node's samples
+//!                                 └root┘└children of n0┘
 //!   area                          Σ A_i
 //!   flux_r flux_g flux_b          Σ E_i A_i            (so E_v = flux / area)
-//!   centroid_x/_y/_z              Σ w_i p_i / Σ w_i,  w_i = flux_r + flux_g + flux_b
+//!   centroid_x/_y/_z              P = Σ w_i p_i / Σ w_i,  w_i = flux_r + flux_g + flux_b
 //!                                 (area-weighted where the node has no flux)
+//!   radius                        max |p_i − P|: the node's bounding sphere about P
+//!   cov_xx cov_yy cov_zz          C = Σ w_i (p_i − P)(p_i − P)ᵀ / Σ w_i, the same weights:
+//!   cov_xy cov_xz cov_yz          for the second-order aggregate (see `traverse.rs`)
 //!   first: u32                    first child (internal) or first sample (leaf)
 //!   info:  u32                    bit 31 = leaf; bits 0..4 = count (1..=8)
 //! ```
 //!
-//! Per sample 28 bytes; per node 60 bytes; with at most [`LEAF_CAPACITY`] samples per leaf
-//! there are about 0.3–0.5 nodes per sample, so about 45–58 bytes per sample in all
+//! Per sample 28 bytes; per node 64 bytes; with at most [`LEAF_CAPACITY`] samples per leaf
+//! there are about 0.3–0.5 nodes per sample, so about 48–60 bytes per sample in all
 //! ([`IrradianceCache::memory_bytes`] reports the exact figure, measured in the benches).
+//!
+//! Why a bounding sphere and not a box: the traversal already computes |x − P| for the
+//! aggregate, so the sphere's distance costs one square root, and its one column leaves room
+//! for the six covariance columns within the same 64 bytes per node as six box columns plus a
+//! scalar spread (the first design; the full covariance cut the aggregation error 5–30× more).
 //!
 //! Why 8 samples per leaf: a leaf is then exactly one 8-lane batch, and so is the set of an
 //! internal node's children.
@@ -88,12 +95,6 @@ pub(crate) struct Samples {
 /// Node columns in breadth-first order (see the module docs for the layout).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct Nodes {
-    pub min_x: Vec<f32>,
-    pub min_y: Vec<f32>,
-    pub min_z: Vec<f32>,
-    pub max_x: Vec<f32>,
-    pub max_y: Vec<f32>,
-    pub max_z: Vec<f32>,
     pub area: Vec<f32>,
     pub flux_r: Vec<f32>,
     pub flux_g: Vec<f32>,
@@ -101,15 +102,46 @@ pub(crate) struct Nodes {
     pub centroid_x: Vec<f32>,
     pub centroid_y: Vec<f32>,
     pub centroid_z: Vec<f32>,
+    pub radius: Vec<f32>,
+    pub cov_xx: Vec<f32>,
+    pub cov_yy: Vec<f32>,
+    pub cov_zz: Vec<f32>,
+    pub cov_xy: Vec<f32>,
+    pub cov_xz: Vec<f32>,
+    pub cov_yz: Vec<f32>,
     pub first: Vec<u32>,
     pub info: Vec<u32>,
+}
+
+impl Nodes {
+    /// Every f32 column with its name.
+    pub(crate) fn float_columns(&self) -> [(&'static str, &Vec<f32>); NODE_FLOAT_COLUMNS] {
+        [
+            ("area", &self.area),
+            ("flux_r", &self.flux_r),
+            ("flux_g", &self.flux_g),
+            ("flux_b", &self.flux_b),
+            ("centroid_x", &self.centroid_x),
+            ("centroid_y", &self.centroid_y),
+            ("centroid_z", &self.centroid_z),
+            ("radius", &self.radius),
+            ("cov_xx", &self.cov_xx),
+            ("cov_yy", &self.cov_yy),
+            ("cov_zz", &self.cov_zz),
+            ("cov_xy", &self.cov_xy),
+            ("cov_xz", &self.cov_xz),
+            ("cov_yz", &self.cov_yz),
+        ]
+    }
 }
 
 /// Bytes of one sample across all sample columns.
 pub const SAMPLE_BYTES: usize = 7 * core::mem::size_of::<f32>();
 /// Bytes of one node across all node columns.
-pub const NODE_BYTES: usize = 13 * core::mem::size_of::<f32>() + 2 * core::mem::size_of::<u32>();
-const _: () = assert!(SAMPLE_BYTES == 28 && NODE_BYTES == 60);
+pub const NODE_BYTES: usize = 14 * core::mem::size_of::<f32>() + 2 * core::mem::size_of::<u32>();
+/// Every f32 node column, by name (for construction, validation and memory accounting).
+pub(crate) const NODE_FLOAT_COLUMNS: usize = 14;
+const _: () = assert!(SAMPLE_BYTES == 28 && NODE_BYTES == 64);
 
 /// A built irradiance cache: immutable, `Send + Sync`, queried from any number of threads.
 #[derive(Clone, Debug, PartialEq)]
@@ -123,6 +155,8 @@ pub struct IrradianceCache {
     pub(crate) grid: Grid,
     pub(crate) mean_area: f32,
     pub(crate) depth: usize,
+    /// Axis-aligned bounds of all samples.
+    pub(crate) bounds: Option<(Vec3, Vec3)>,
 }
 
 impl IrradianceCache {
@@ -161,13 +195,7 @@ impl IrradianceCache {
     }
     /// Bounds of all samples (`None` when empty).
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        (self.node_len > 0).then(|| {
-            let n = &self.nodes;
-            (
-                Vec3::new(n.min_x[0], n.min_y[0], n.min_z[0]),
-                Vec3::new(n.max_x[0], n.max_y[0], n.max_z[0]),
-            )
-        })
+        self.bounds
     }
 
     /// Heap and inline bytes held by the cache, everything included (column capacities and
@@ -179,26 +207,11 @@ impl IrradianceCache {
         let sample_cols = [
             &s.pos_x, &s.pos_y, &s.pos_z, &s.area, &s.flux_r, &s.flux_g, &s.flux_b,
         ];
-        let node_cols = [
-            &n.min_x,
-            &n.min_y,
-            &n.min_z,
-            &n.max_x,
-            &n.max_y,
-            &n.max_z,
-            &n.area,
-            &n.flux_r,
-            &n.flux_g,
-            &n.flux_b,
-            &n.centroid_x,
-            &n.centroid_y,
-            &n.centroid_z,
-        ];
-        let floats: usize = sample_cols
-            .iter()
-            .chain(node_cols.iter())
-            .map(|c| c.capacity() * f)
-            .sum();
+        let floats: usize = sample_cols.iter().map(|c| c.capacity() * f).sum::<usize>()
+            + n.float_columns()
+                .iter()
+                .map(|(_, c)| c.capacity() * f)
+                .sum::<usize>();
         let ints = (n.first.capacity() + n.info.capacity()) * core::mem::size_of::<u32>();
         core::mem::size_of::<Self>() + floats + ints
     }

@@ -38,8 +38,9 @@ fn close(a: f32, b: f64) -> bool {
 impl IrradianceCache {
     /// Checks every invariant: column lengths and zero padding; breadth-first node order with
     /// contiguous children after their parent; leaves of 1..=8 samples partitioning the
-    /// samples; depth; Morton order of the samples; and every aggregate (area, flux, tight
-    /// bounds, centroid inside the bounds) against a fresh sum of its children.
+    /// samples; depth; Morton order of the samples; every aggregate (area, flux) against a
+    /// fresh sum of its children; every sample inside its ancestors' spheres; covariances
+    /// positive semi-definite on the diagonal pairs and bounded by the radius.
     pub fn validate(&self) -> Result<(), ValidationError> {
         let (n, m) = (self.len, self.node_len);
         let s = &self.samples;
@@ -64,21 +65,7 @@ impl IrradianceCache {
                 "sample column {name} padding is not zero"
             );
         }
-        for (name, col) in [
-            ("min_x", &d.min_x),
-            ("min_y", &d.min_y),
-            ("min_z", &d.min_z),
-            ("max_x", &d.max_x),
-            ("max_y", &d.max_y),
-            ("max_z", &d.max_z),
-            ("area", &d.area),
-            ("flux_r", &d.flux_r),
-            ("flux_g", &d.flux_g),
-            ("flux_b", &d.flux_b),
-            ("centroid_x", &d.centroid_x),
-            ("centroid_y", &d.centroid_y),
-            ("centroid_z", &d.centroid_z),
-        ] {
+        for (name, col) in d.float_columns() {
             ensure!(
                 col.len() == m + LANES,
                 "node column {name} has {} entries, expected {}",
@@ -193,13 +180,13 @@ impl IrradianceCache {
         );
 
         // Aggregates, bottom-up, and contiguous sample ranges.
+        let centroid =
+            |i: usize| glam::Vec3::new(d.centroid_x[i], d.centroid_y[i], d.centroid_z[i]);
         for i in (0..m).rev() {
             let info = d.info[i];
             let (first, count) = (d.first[i] as usize, (info & COUNT_MASK) as usize);
             let mut area = 0.0f64;
             let mut flux = [0.0f64; 3];
-            let mut lo = [f32::INFINITY; 3];
-            let mut hi = [f32::NEG_INFINITY; 3];
             if info & LEAF_BIT != 0 {
                 range[i] = (first as u32, (first + count) as u32);
                 for j in first..first + count {
@@ -207,10 +194,6 @@ impl IrradianceCache {
                     flux[0] += s.flux_r[j] as f64;
                     flux[1] += s.flux_g[j] as f64;
                     flux[2] += s.flux_b[j] as f64;
-                    for (a, v) in [s.pos_x[j], s.pos_y[j], s.pos_z[j]].into_iter().enumerate() {
-                        lo[a] = lo[a].min(v);
-                        hi[a] = hi[a].max(v);
-                    }
                 }
             } else {
                 range[i] = (range[first].0, range[first + count - 1].1);
@@ -225,10 +208,12 @@ impl IrradianceCache {
                     flux[0] += d.flux_r[c] as f64;
                     flux[1] += d.flux_g[c] as f64;
                     flux[2] += d.flux_b[c] as f64;
-                    for a in 0..3 {
-                        lo[a] = lo[a].min([d.min_x[c], d.min_y[c], d.min_z[c]][a]);
-                        hi[a] = hi[a].max([d.max_x[c], d.max_y[c], d.max_z[c]][a]);
-                    }
+                    // A child's centroid lies within its parent's sphere.
+                    let offset = (centroid(c) - centroid(i)).length() as f64;
+                    ensure!(
+                        offset <= (d.radius[i] as f64) * (1.0 + 1e-5) + 1e-30,
+                        "node {i}: child {c}'s centroid is outside the node's sphere"
+                    );
                 }
             }
             ensure!(
@@ -242,16 +227,43 @@ impl IrradianceCache {
                     && close(d.flux_b[i], flux[2]),
                 "node {i} flux does not match its children"
             );
-            let nlo = [d.min_x[i], d.min_y[i], d.min_z[i]];
-            let nhi = [d.max_x[i], d.max_y[i], d.max_z[i]];
+            // Every sample of the subtree lies within the sphere about the centroid.
+            let r = d.radius[i] as f64;
+            let (a, b) = (range[i].0 as usize, range[i].1 as usize);
+            let farthest = (a..b)
+                .map(|j| {
+                    (glam::Vec3::new(s.pos_x[j], s.pos_y[j], s.pos_z[j]) - centroid(i))
+                        .as_dvec3()
+                        .length()
+                })
+                .fold(0.0f64, f64::max);
             ensure!(
-                nlo == lo && nhi == hi,
-                "node {i} bounds {nlo:?}..{nhi:?} are not the tight {lo:?}..{hi:?}"
+                farthest <= r * (1.0 + 1e-6) + 1e-30,
+                "node {i}: a sample lies {farthest} from the centroid, radius {r}"
             );
-            let c = [d.centroid_x[i], d.centroid_y[i], d.centroid_z[i]];
+            // The covariance: non-negative variances, |off-diagonals| ≤ geometric means, and the
+            // total variance at most the squared radius.
+            let (xx, yy, zz) = (d.cov_xx[i] as f64, d.cov_yy[i] as f64, d.cov_zz[i] as f64);
             ensure!(
-                (0..3).all(|a| c[a] >= lo[a] && c[a] <= hi[a]),
-                "node {i} centroid {c:?} outside its bounds"
+                xx >= 0.0 && yy >= 0.0 && zz >= 0.0,
+                "node {i}: negative variance"
+            );
+            let slack = 1e-5 * (xx + yy + zz) + 1e-30;
+            for (c, p, q) in [
+                (d.cov_xy[i] as f64, xx, yy),
+                (d.cov_xz[i] as f64, xx, zz),
+                (d.cov_yz[i] as f64, yy, zz),
+            ] {
+                ensure!(
+                    c.abs() <= libm::sqrt(p * q) + slack,
+                    "node {i}: covariance {c} exceeds √({p}·{q})"
+                );
+            }
+            ensure!(
+                xx + yy + zz <= r * r * (1.0 + 1e-5) + 1e-30,
+                "node {i}: total variance {} exceeds radius² {}",
+                xx + yy + zz,
+                r * r
             );
         }
         ensure!(
