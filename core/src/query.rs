@@ -218,6 +218,7 @@ impl IrradianceCache {
             epsilon: settings.epsilon,
             cull_tolerance: settings.cull_tolerance,
             kernel: Kernel::new(settings.smoothing_radius),
+            irradiance: point.irradiance,
         };
         let x = point.position;
         let e = point.irradiance;

@@ -130,8 +130,17 @@ fn split_methods_match_brute_force_oracles() {
         let alpha = cache.smoothing_radius(k);
         let table = LocalIntegralTable::new(&p, alpha, 0.0).unwrap();
         let kk = table.lookup(p.mean_free_path());
-        for x in query_points(150, 6) {
-            let sp = point(x);
+        // Both lit-everywhere-in-blue shading points and points whose own irradiance follows
+        // the light (zero on the dark side, where N10 skips its deferred unlit subtrees).
+        let dark_too = |x: Vec3| ShadingPoint {
+            position: x,
+            irradiance: Vec3::splat(x.z.max(0.0)),
+        };
+        for sp in query_points(150, 6)
+            .into_iter()
+            .flat_map(|x| [point(x), dark_too(x)])
+        {
+            let x = sp.position;
             let lg = exhaustive_local_global(&cache, &p, x, sp.irradiance, kk, alpha);
             let ea = exhaustive_edge_aware(&cache, &p, x, sp.irradiance, kk, alpha);
             for (method, want) in [(Method::LocalGlobal, lg), (Method::EdgeAware, ea)] {
