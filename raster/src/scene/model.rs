@@ -267,7 +267,7 @@ impl Default for RenderSettings {
         RenderSettings {
             method: SssMethod::EdgeAware,
             samples: SampleDensity::Count(23_000),
-            epsilon: 0.05,
+            epsilon: 0.5,
             smoothing: 1.5,
             ell_min: None,
             cull_tolerance: 1e-4,
