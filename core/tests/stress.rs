@@ -752,9 +752,10 @@ fn extreme_smoothing_radii() {
     }
 }
 
-/// Extreme positions: samples and shading points up to ±f32::MAX / 4 (the bounding box's
-/// extent still fits f32), tiny clusters far from the origin, and shading points at ±1e38:
-/// builds validate and every query is finite.
+/// Extreme positions: samples spread to ±8e37 and to ±3e38 (where the bounding box's extent
+/// overflows f32), tiny clusters far from the origin, samples at 1e-30 and 1e30 together,
+/// and shading points at ±1e38: builds validate and every query is finite and exact where
+/// promised.
 #[test]
 fn extreme_positions() {
     let p = profile(Vec3::new(0.3, 0.6, 0.9), Vec3::new(0.1, 0.3, 1.0), 1.3);
@@ -765,6 +766,18 @@ fn extreme_positions() {
             (0..200)
                 .map(|_| Sample {
                     position: rng.vec3(-1.0, 1.0) * 8e37,
+                    area: 1.0,
+                    irradiance: Vec3::ONE,
+                })
+                .collect(),
+        ),
+        (
+            // The bounding box's extent overflows: the Morton grid degenerates to one cell and
+            // the build splits by count alone.
+            "spread to ±3e38",
+            (0..200)
+                .map(|_| Sample {
+                    position: rng.vec3(-1.0, 1.0) * 3e38,
                     area: 1.0,
                     irradiance: Vec3::ONE,
                 })
