@@ -304,3 +304,18 @@ fn scene_beyond_single_precision() {
     let message = sb.fails(&render(&[]), 1, &["exceed single precision", "object 0"]);
     assert!(!message.contains("internal"), "{message}");
 }
+
+/// Mean free paths the scene format accepts (> 0) but the f32 dipole cannot represent
+/// (below 2.3e-13, above about 1e12; see docs/valid-ranges.md): an error naming the material.
+#[test]
+fn mean_free_path_beyond_single_precision() {
+    for ell in ["1e-14", "1e13"] {
+        let material = CONSTANT.replace("0.05", ell);
+        let sb = Sandbox::with_scene("scene-mfp", &scene(SPHERE, &material));
+        sb.fails(
+            &render(&[]),
+            1,
+            &["material 'm': mean free path", "single precision"],
+        );
+    }
+}
