@@ -199,9 +199,21 @@ impl Dipole {
             rd_total: total_reflectance(albedo, eta as f64) as f32,
         };
         // Both source depths squared must be normal floats with headroom for r² (else Rd(0)
-        // overflows or the profile underflows to nothing), and Rd(0) must be finite.
+        // overflows or the profile underflows to nothing), and Rd(0) must be finite. `rd`
+        // divides by d³, which leaves f32 long before d² does: z_r³ underflows for z_r below
+        // ∛MIN_POSITIVE ≈ 2.3e-13 (then Rd(0) = ∞, and (1 − w)·Rd = 0·∞ turns the split
+        // methods' sums into NaN), and z_v³ overflows for z_v above ∛MAX ≈ 7e12 (then the
+        // virtual source's term is 0 at every r and Rd ≡ 0 or is missing a term). Both cubes
+        // must be normal floats, and Rd(0) evaluated in f32 finite.
         let ok = |v: f32| v.is_finite() && v >= f32::MIN_POSITIVE;
-        if !(ok(d.z_r2) && ok(d.z_v2) && d.z_v2 < 1e30 && d.rd_zero.is_finite() && d.rd_zero > 0.0)
+        if !(ok(d.z_r2)
+            && ok(d.z_v2)
+            && ok(d.z_r * d.z_r2)
+            && ok(d.z_v * d.z_v2)
+            && d.z_v2 < 1e30
+            && d.rd_zero.is_finite()
+            && d.rd_zero > 0.0
+            && d.rd(0.0).is_finite())
         {
             return Err(ParamError::OutOfRange {
                 name: "mean free path",

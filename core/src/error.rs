@@ -95,6 +95,14 @@ pub enum BuildError {
         /// The offending value.
         value: f32,
     },
+    /// The samples' total area, or their total flux (irradiance × area) in some channel,
+    /// exceeds the f32 range the cache stores its sums in.
+    TotalOverflow {
+        /// `"area"` or `"flux"`.
+        quantity: &'static str,
+        /// The total, in double precision.
+        value: f64,
+    },
     /// More samples than the 32-bit indices can address.
     TooManySamples {
         /// How many were given.
@@ -117,6 +125,11 @@ impl fmt::Display for BuildError {
             BuildError::InvalidIrradiance { index, value } => write!(
                 f,
                 "sample {index}: irradiance must be finite and non-negative, got {value}"
+            ),
+            BuildError::TotalOverflow { quantity, value } => write!(
+                f,
+                "the samples' total {quantity} {value:e} exceeds single precision (at most {:e})",
+                f32::MAX
             ),
             BuildError::TooManySamples { count } => {
                 write!(

@@ -21,9 +21,12 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// The kernel of radius α (α = 0 gives w ≡ 0: no smoothing).
+    /// The kernel of radius α (α = 0 gives w ≡ 0: no smoothing). A radius whose square is not
+    /// a normal float (α < 1.1e-19) is no smoothing too: 1/α² would overflow and w(0) would be
+    /// 1 − 0·∞ = NaN. (Such a kernel covers nothing but samples exactly at x, and its local
+    /// integral K is 0 to f32 precision, so the split is then JB02's sum either way.)
     pub fn new(radius: f32) -> Self {
-        let radius = if radius.is_finite() && radius > 0.0 {
+        let radius = if radius.is_finite() && radius > 0.0 && radius * radius >= f32::MIN_POSITIVE {
             radius
         } else {
             0.0

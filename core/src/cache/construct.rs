@@ -33,6 +33,10 @@ fn check(samples: &[Sample]) -> Result<(), BuildError> {
             count: samples.len(),
         });
     }
+    // Node sums are stored in f32: the root's (the largest) must fit, or the cache would hold
+    // infinities (and `validate` would reject it).
+    let mut total_area = 0.0_f64;
+    let mut total_flux = DVec3::ZERO;
     for (index, s) in samples.iter().enumerate() {
         if !s.position.is_finite() {
             return Err(BuildError::NonFinitePosition { index });
@@ -54,6 +58,13 @@ fn check(samples: &[Sample]) -> Result<(), BuildError> {
                 index,
                 value: flux.max_element(),
             });
+        }
+        total_area += s.area as f64;
+        total_flux += flux.as_dvec3();
+    }
+    for (quantity, value) in [("area", total_area), ("flux", total_flux.max_element())] {
+        if !(value as f32).is_finite() {
+            return Err(BuildError::TotalOverflow { quantity, value });
         }
     }
     Ok(())

@@ -142,6 +142,37 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
     Ok(())
 }
 
+/// Checks, before rendering, that every output path can be written: it names a file, its
+/// directory exists, it is not itself a directory, and no path is given twice. Each write is
+/// atomic on its own, but a render writes the PNG and then the EXR: without this check, an EXR
+/// path in a missing directory failed only after the PNG had been replaced (exit 1 with a
+/// changed file), and the whole render was wasted.
+fn check_outputs(paths: &[&Path]) -> Result<(), String> {
+    for (i, path) in paths.iter().enumerate() {
+        let shown = path.display();
+        if path.file_name().is_none() {
+            return Err(format!("{shown}: the output path does not name a file"));
+        }
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        if !dir.is_dir() {
+            return Err(format!(
+                "{shown}: cannot write there: the directory '{}' does not exist",
+                dir.display()
+            ));
+        }
+        if path.is_dir() {
+            return Err(format!("{shown}: cannot write there: it is a directory"));
+        }
+        if paths[..i].contains(path) {
+            return Err(format!("{shown}: given as both the PNG and the EXR output"));
+        }
+    }
+    Ok(())
+}
+
 fn seconds(d: std::time::Duration) -> String {
     format!("{:.2} s", d.as_secs_f64())
 }
@@ -150,6 +181,12 @@ fn seconds(d: std::time::Duration) -> String {
 pub fn render(args: &RenderArgs) -> Result<(), String> {
     let mut scene = load(args.scene.as_deref())?;
     apply(args, &mut scene)?;
+    let outputs: Vec<&Path> = [&scene.output.png, &scene.output.exr]
+        .into_iter()
+        .flatten()
+        .map(|p| p.as_path())
+        .collect();
+    check_outputs(&outputs)?;
     let baked = match &args.samples_from {
         Some(path) => {
             let groups = read_baked(path).map_err(|e| e.to_string())?;

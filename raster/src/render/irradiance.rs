@@ -131,8 +131,16 @@ pub fn build_caches(sets: &[ObjectSamples]) -> Result<Vec<IrradianceCache>, Rend
                     irradiance: s.irradiance[i],
                 })
                 .collect();
-            IrradianceCache::build(&samples)
-                .map_err(|e| RenderError::Core(format!("irradiance cache: {e}")))
+            // Samples are validated where they are made (placement, lights, the PLY reader),
+            // so what the build can still reject is sums beyond f32: a scene far too large or
+            // lights far too bright. That is a limit of the input, not an internal error.
+            IrradianceCache::build(&samples).map_err(|e| {
+                RenderError::Limit(format!(
+                    "the irradiance samples of object {} exceed single precision: {e} (scene \
+                     too large, or lights too bright?)",
+                    s.object
+                ))
+            })
         })
         .collect()
 }

@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lucent_core::{Method, NoStats, QuerySettings, QueryStats};
+use lucent_core::{IrradianceCache, Method, NoStats, QuerySettings, QueryStats};
 use rayon::prelude::*;
 
 pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
@@ -255,23 +255,50 @@ fn render_in_pool(
     let built = irradiance::build_caches(&sets)?;
     let mut caches: Vec<Option<ObjectCache>> = (0..scene.objects.len()).map(|_| None).collect();
     let mut cache_bytes = 0;
+    let local_term = |object: usize, alpha: f32| match prep.shader_of(object) {
+        Shader::Translucent(shader) if method.is_split() && alpha > 0.0 => {
+            let ell_min = settings.ell_min.unwrap_or(alpha / 1024.0);
+            shader
+                .local_term(alpha, ell_min)
+                .map(Some)
+                .map_err(|e| RenderError::Material(format!("material '{}': {e}", shader.name)))
+        }
+        _ => Ok(None),
+    };
     for (set, cache) in sets.iter().zip(built) {
         let alpha = cache.smoothing_radius(settings.smoothing);
-        let local = match prep.shader_of(set.object) {
-            Shader::Translucent(shader) if method.is_split() && alpha > 0.0 => {
-                let ell_min = settings.ell_min.unwrap_or(alpha / 1024.0);
-                Some(shader.local_term(alpha, ell_min).map_err(|e| {
-                    RenderError::Material(format!("material '{}': {e}", shader.name))
-                })?)
-            }
-            _ => None,
-        };
+        let local = local_term(set.object, alpha)?;
         cache_bytes += cache.memory_bytes();
         caches[set.object] = Some(ObjectCache {
             cache,
             alpha,
             local,
         });
+    }
+    // A translucent object far smaller than the sample spacing can receive no sample at all.
+    // It gets an empty cache and the smoothing radius of the shared spacing: the split methods
+    // shade it with their local term alone, E(x)·K (the Lambertian limit when α ≫ ℓ), the
+    // unsplit ones with no subsurface light. (Without this, shading it failed with "internal
+    // error: no irradiance cache".)
+    let (area, count) = sets
+        .iter()
+        .flat_map(|s| &s.areas)
+        .fold((0.0, 0usize), |(a, n), &x| (a + f64::from(x), n + 1));
+    let spacing_area = if count > 0 {
+        (area / count as f64) as f32
+    } else {
+        0.0
+    };
+    for object in prep.translucent_objects() {
+        if caches[object].is_none() {
+            let alpha = settings.smoothing * spacing_area.sqrt();
+            caches[object] = Some(ObjectCache {
+                cache: IrradianceCache::build(&[])
+                    .map_err(|e| RenderError::Core(format!("empty irradiance cache: {e}")))?,
+                alpha,
+                local: local_term(object, alpha)?,
+            });
+        }
     }
     timings.cache = t.elapsed();
 

@@ -1,0 +1,103 @@
+//! Output paths that cannot be written, and `compare` on bad images: nothing is written or
+//! replaced, and no temporary file is left behind.
+
+use crate::harness::{PREVIOUS, Sandbox, render};
+
+/// PNG and EXR paths in a missing directory, naming a directory, or the same file twice:
+/// rejected before rendering, both outputs untouched.
+#[test]
+fn unwritable_output_paths() {
+    let sb = Sandbox::new("out-paths");
+    std::fs::create_dir(sb.path("adir")).unwrap();
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &["-o", "nodir/x.png"],
+            &["nodir/x.png", "the directory 'nodir' does not exist"],
+        ),
+        (
+            &["--exr", "nodir/x.exr"],
+            &["nodir/x.exr", "the directory 'nodir' does not exist"],
+        ),
+        (
+            &["-o", "adir"],
+            &["adir: cannot write there: it is a directory"],
+        ),
+        (
+            &["--exr", "adir"],
+            &["adir: cannot write there: it is a directory"],
+        ),
+        (&["-o", "same", "--exr", "same"], &["given as both"]),
+        (&["-o", "/"], &["does not name a file"]),
+    ];
+    for (extra, needles) in cases {
+        sb.fails(&render(extra), 1, needles);
+    }
+}
+
+/// The bug this suite found: with a good PNG path and an EXR path in a missing directory,
+/// the PNG used to be replaced before the EXR failed. Both outputs now stay as they were.
+#[test]
+fn failing_exr_does_not_replace_the_png() {
+    let sb = Sandbox::new("out-partial");
+    sb.fails(
+        &render(&["-o", "out.png", "--exr", "missing/out.exr"]),
+        1,
+        &["missing/out.exr"],
+    );
+    assert_eq!(sb.read("out.png"), PREVIOUS);
+}
+
+/// Bake: an output in a missing directory or naming a directory.
+#[test]
+fn unwritable_bake_output() {
+    let sb = Sandbox::new("out-bake");
+    std::fs::create_dir(sb.path("adir")).unwrap();
+    sb.fails(
+        &["bake", "scene.toml", "-q", "-o", "nodir/s.ply"],
+        1,
+        &["nodir/s.ply"],
+    );
+    sb.fails(&["bake", "scene.toml", "-q", "-o", "adir"], 1, &["adir"]);
+    // A bad scene never reaches the writer.
+    sb.fails(
+        &["bake", "nosuch.toml", "-q", "-o", "s.ply"],
+        1,
+        &["nosuch.toml: cannot read scene"],
+    );
+}
+
+/// `compare` on missing, truncated and non-image files, and of different sizes: an error
+/// naming the file, and no heat map written.
+#[test]
+fn compare_bad_images() {
+    let sb = Sandbox::new("out-compare");
+    sb.succeeds(&render(&[]));
+    let png = sb.read("out.png");
+    sb.write("a.png", &png);
+    sb.write("cut.png", &png[..png.len() / 2]);
+    sb.write("junk.exr", b"not an exr at all");
+    let small = Sandbox::with_scene(
+        "out-compare-small",
+        &String::from_utf8(sb.read("scene.toml"))
+            .unwrap()
+            .replace("width = 32", "width = 16"),
+    );
+    small.succeeds(&render(&[]));
+    sb.write("small.png", &small.read("out.png"));
+    let heat = ["--heatmap", "heat.png"];
+    let cases: &[(&[&str], &[&str])] = &[
+        (&["compare", "a.png", "nosuch.png"], &["nosuch.png"]),
+        (&["compare", "cut.png", "a.png"], &["cut.png"]),
+        (&["compare", "a.png", "junk.exr"], &["junk.exr"]),
+        (
+            &["compare", "a.png", "scene.toml"],
+            &["scene.toml", "unknown image type"],
+        ),
+        (&["compare", "a.png", "small.png"], &["32", "16"]),
+    ];
+    for (args, needles) in cases {
+        let mut all = args.to_vec();
+        all.extend_from_slice(&heat);
+        sb.fails(&all, 1, needles);
+    }
+}

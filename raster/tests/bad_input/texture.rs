@@ -1,0 +1,174 @@
+//! PNG textures: missing, not PNG, absurd sizes in the header, truncated, corrupt, and
+//! textures on a mesh without UVs.
+
+use crate::harness::{
+    CONSTANT, SPHERE, Sandbox, png_chunk, png_header_only, render, scene, valid_png,
+};
+
+const KD_TEXTURE: &str = "kd = { texture = \"kd.png\" }\nmean_free_path = 0.05";
+const ELL_TEXTURE: &str =
+    "kd = 0.7\nmean_free_path = { texture = \"kd.png\", min = 0.01, max = 0.1 }";
+
+fn texture_sandbox(tag: &str, material: &str) -> Sandbox {
+    let sb = Sandbox::with_scene(tag, &scene(SPHERE, material));
+    valid_png(&sb, "kd.png", 4, 4);
+    sb
+}
+
+#[test]
+fn valid_textures_render() {
+    for material in [KD_TEXTURE, ELL_TEXTURE] {
+        let sb = texture_sandbox("texture-valid", material);
+        sb.succeeds(&render(&[]));
+    }
+}
+
+#[test]
+fn missing_texture() {
+    for (material, key) in [
+        (KD_TEXTURE, "material.m.kd.texture"),
+        (ELL_TEXTURE, "material.m.mean_free_path.texture"),
+    ] {
+        let sb = texture_sandbox("texture-missing", material);
+        std::fs::remove_file(sb.path("kd.png")).unwrap();
+        sb.fails(
+            &render(&[]),
+            1,
+            &[
+                "scene.toml:",
+                key,
+                "cannot read texture kd.png",
+                "No such file",
+            ],
+        );
+    }
+}
+
+/// Files that are not PNG, or whose header claims an empty or absurd size: rejected before
+/// anything is allocated, naming the texture.
+#[test]
+fn textures_of_the_wrong_format_or_size() {
+    let jpeg: Vec<u8> = [
+        &[0xff, 0xd8, 0xff, 0xe0, 0x00, 0x10][..],
+        b"JFIF\0",
+        &[1, 1, 0, 0, 1, 0, 1, 0, 0, 0xff, 0xd9],
+    ]
+    .concat();
+    let exr = [0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, 0, 0, 0, 0];
+    let cases: Vec<(&str, Vec<u8>, &[&str])> = vec![
+        (
+            "a JPEG named .png",
+            jpeg,
+            &["not a readable PNG", "signature"],
+        ),
+        (
+            "an OpenEXR named .png",
+            exr.to_vec(),
+            &["not a readable PNG"],
+        ),
+        ("text", b"not an image\n".to_vec(), &["not a readable PNG"]),
+        ("empty", Vec::new(), &["PNG"]),
+        ("0 × 0", png_header_only(0, 0), &["PNG"]),
+        ("0 × 16", png_header_only(0, 16), &["PNG"]),
+        (
+            "100000 × 100000",
+            png_header_only(100_000, 100_000),
+            &["100000 × 100000", "larger than 16384 texels per side"],
+        ),
+        (
+            "16384 × 16384",
+            png_header_only(16_384, 16_384),
+            &["16384 × 16384", "more than 16777216 texels"],
+        ),
+        (
+            "2³¹ − 1 wide",
+            png_header_only(0x7fff_ffff, 1),
+            &["2147483647 × 1", "larger than 16384 texels per side"],
+        ),
+        ("4 × 4 without pixel data", png_header_only(4, 4), &["PNG"]),
+    ];
+    for material in [KD_TEXTURE, ELL_TEXTURE] {
+        let sb = texture_sandbox("texture-format", material);
+        for (what, bytes, needles) in &cases {
+            sb.write("kd.png", bytes);
+            let mut all = vec!["scene.toml:", "texture kd.png"];
+            all.extend_from_slice(needles);
+            let message = sb.fails(&render(&[]), 1, &all);
+            assert!(!message.contains("internal"), "{what}: {message}");
+        }
+        // A directory named like the texture.
+        std::fs::remove_file(sb.path("kd.png")).unwrap();
+        std::fs::create_dir(sb.path("kd.png")).unwrap();
+        sb.fails(&render(&[]), 1, &["cannot read texture kd.png"]);
+    }
+}
+
+/// A valid PNG cut at every byte: each prefix is an error naming the texture (the decoder
+/// needs the image data, and with it the file is complete but for the end chunk).
+#[test]
+fn truncated_png() {
+    let sb = texture_sandbox("texture-truncated", KD_TEXTURE);
+    let png = sb.read("kd.png");
+    let iend = png.len() - 12;
+    for cut in 0..png.len() {
+        sb.write("kd.png", &png[..cut]);
+        if cut < iend {
+            sb.fails(&render(&[]), 1, &["scene.toml:", "texture kd.png"]);
+        } else {
+            sb.succeeds_or_fails(&render(&[]), "texture kd.png");
+        }
+    }
+}
+
+/// Corrupt image data with valid chunk CRCs (the zlib stream damaged) and a damaged CRC:
+/// errors naming the texture.
+#[test]
+fn corrupt_png() {
+    let sb = texture_sandbox("texture-corrupt", KD_TEXTURE);
+    let png = sb.read("kd.png");
+    // Locate the IDAT chunk: length, type, data, CRC.
+    let at = png.windows(4).position(|w| w == b"IDAT").unwrap() - 4;
+    let len = u32::from_be_bytes(png[at..at + 4].try_into().unwrap()) as usize;
+    let data = &png[at + 8..at + 8 + len];
+    let rest = &png[at + 12 + len..];
+    for flip in [0, 1, len / 2, len - 1] {
+        let mut bad = data.to_vec();
+        bad[flip] ^= 0x5a;
+        let rebuilt = [&png[..at], &png_chunk(b"IDAT", &bad), rest].concat();
+        sb.write("kd.png", &rebuilt);
+        sb.succeeds_or_fails(&render(&[]), "texture kd.png");
+    }
+    // A broken zlib header is always fatal.
+    let mut bad = data.to_vec();
+    bad[0] = 0xff;
+    bad[1] = 0xff;
+    sb.write(
+        "kd.png",
+        &[&png[..at], &png_chunk(b"IDAT", &bad), rest].concat(),
+    );
+    sb.fails(&render(&[]), 1, &["texture kd.png"]);
+    // A damaged CRC in the header chunk.
+    let mut bad = png.clone();
+    bad[29] ^= 0xff;
+    sb.write("kd.png", &bad);
+    sb.fails(&render(&[]), 1, &["texture kd.png"]);
+}
+
+/// A textured material on an OBJ without texture coordinates.
+#[test]
+fn texture_on_mesh_without_uvs() {
+    let sb = Sandbox::with_scene("texture-no-uv", &scene("obj = \"mesh.obj\"", KD_TEXTURE));
+    valid_png(&sb, "kd.png", 4, 4);
+    sb.write("mesh.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    sb.fails(
+        &render(&[]),
+        1,
+        &["object[0].obj", "no texture coordinates", "kd"],
+    );
+    // The same mesh with a constant material renders.
+    sb.write(
+        "scene.toml",
+        scene("obj = \"mesh.obj\"", CONSTANT).as_bytes(),
+    );
+    sb.succeeds(&render(&[]));
+}
