@@ -431,6 +431,17 @@ fn covariances(pending: &[Pending], s: &Samples, sums: &[Sums], centroids: &[DVe
         }
         cov[i] = acc * (1.0 / node.total_weight().max(f64::MIN_POSITIVE));
     }
+    // A node whose covariance does not fit f32 (coordinates beyond ~1e19) gets none: its
+    // aggregate falls back to JB02's plain one.
+    for c in &mut cov {
+        if !c
+            .to_cols_array()
+            .iter()
+            .all(|v| v.is_finite() && v.abs() <= f32::MAX as f64)
+        {
+            *c = DMat3::ZERO;
+        }
+    }
     cov
 }
 
@@ -448,7 +459,7 @@ fn radii(pending: &[Pending], s: &Samples, centroids: &[DVec3]) -> Vec<f32> {
                 let pos = DVec3::new(s.pos_x[j] as f64, s.pos_y[j] as f64, s.pos_z[j] as f64);
                 r2 = r2.max((pos - centre).length_squared());
             }
-            let r = libm::sqrt(r2);
+            let r = libm::sqrt(r2).min(f32::MAX as f64);
             let rounded = r as f32;
             if (rounded as f64) < r {
                 rounded.next_up()

@@ -330,12 +330,14 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                     + syy * cy * cy
                     + szz * cz * cz
                     + L::splat(2.0) * (sxy * cx * cy + sxz * cx * cz + syz * cy * cz);
-                // Aggregated lanes are outside their sphere, so dist2 > 0 there.
-                let q = vcv / dist2;
-                if self.aggregates.append(
-                    aggregate,
-                    [dist2, flux[0], flux[1], flux[2], q, sxx + syy + szz],
-                ) {
+                // Aggregated lanes are outside their sphere, so dist2 > 0 there; q ≤ λ_max ≤ tr C
+                // mathematically, and the clamp keeps overflowed lanes (∞/∞) finite.
+                let trace = sxx + syy + szz;
+                let q = (vcv / dist2).min(trace).max(zero);
+                if self
+                    .aggregates
+                    .append(aggregate, [dist2, flux[0], flux[1], flux[2], q, trace])
+                {
                     self.evaluate_aggregates(LANES);
                     self.aggregates.consume();
                 }

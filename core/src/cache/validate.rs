@@ -209,7 +209,7 @@ impl IrradianceCache {
                     flux[1] += d.flux_g[c] as f64;
                     flux[2] += d.flux_b[c] as f64;
                     // A child's centroid lies within its parent's sphere.
-                    let offset = (centroid(c) - centroid(i)).length() as f64;
+                    let offset = (centroid(c).as_dvec3() - centroid(i).as_dvec3()).length();
                     ensure!(
                         offset <= (d.radius[i] as f64) * (1.0 + 1e-5) + 1e-30,
                         "node {i}: child {c}'s centroid is outside the node's sphere"
@@ -227,18 +227,19 @@ impl IrradianceCache {
                     && close(d.flux_b[i], flux[2]),
                 "node {i} flux does not match its children"
             );
-            // Every sample of the subtree lies within the sphere about the centroid.
+            // Every sample of the subtree lies within the sphere about the centroid (a radius of
+            // f32::MAX stands for a sphere too large for f32: unbounded).
             let r = d.radius[i] as f64;
             let (a, b) = (range[i].0 as usize, range[i].1 as usize);
             let farthest = (a..b)
                 .map(|j| {
-                    (glam::Vec3::new(s.pos_x[j], s.pos_y[j], s.pos_z[j]) - centroid(i))
-                        .as_dvec3()
-                        .length()
+                    (glam::Vec3::new(s.pos_x[j], s.pos_y[j], s.pos_z[j]).as_dvec3()
+                        - centroid(i).as_dvec3())
+                    .length()
                 })
                 .fold(0.0f64, f64::max);
             ensure!(
-                farthest <= r * (1.0 + 1e-6) + 1e-30,
+                farthest <= r * (1.0 + 1e-6) + 1e-30 || d.radius[i] == f32::MAX,
                 "node {i}: a sample lies {farthest} from the centroid, radius {r}"
             );
             // The covariance: non-negative variances, |off-diagonals| ≤ geometric means, and the
