@@ -4,8 +4,11 @@
 //! K(ℓ_u) = 2π ∫₀^α w(r) Rd_ℓ(r) r dr            (LM07; w the quartic kernel of radius α)
 //! ```
 //!
-//! cached on demand at ℓ_u = 2^k and interpolated between the two bracketing powers of two, so
-//! that a texture-mapped ℓ_u costs a lookup instead of a quadrature.
+//! cached on demand at ℓ_u = α·2^k — powers of two as N10 prescribes, in units of the smoothing
+//! radius so that the table is scale invariant (K depends on α/ℓ only; with nodes at absolute
+//! 2^k scene units the same scene in other units saw up to 3.9% different K) — and
+//! interpolated between the two bracketing nodes, so that a texture-mapped ℓ_u costs a lookup
+//! instead of a quadrature.
 //!
 //! The interpolation is linear in log K against log ℓ. Measured maximum relative error
 //! against the exact K over ℓ/α ∈ [2⁻¹⁰, 2¹⁰] (K_d from 0.05 to 0.99, test
@@ -28,7 +31,7 @@
 //!      │                       ●──●
 //!      │                           ╲●──●──●──… → 0
 //!      └──────┬────────┬───┬───┬───┬────────── ℓ_u
-//!           ℓ_min    2^k₀ 2^k₀⁺¹ …
+//!           ℓ_min   α2^k₀ α2^k₀⁺¹ …
 //! ```
 //!
 //! Below the user's ℓ_min the limit value is used; between ℓ_min and the first power of two
@@ -108,9 +111,11 @@ pub struct LocalIntegralTable {
     channels: [Channel; 3],
     alpha: f32,
     ell_min: f32,
-    /// Exponent of the first cached node: the smallest k with 2^k > ℓ_min.
+    /// ℓ_min / α.
+    ratio_min: f32,
+    /// Exponent of the first cached node: the smallest k with 2^k > ℓ_min / α.
     k_lo: i32,
-    /// `entries[k − k_lo][c]` = K at ℓ = 2^k for channel c, as f32 bits, or `EMPTY`.
+    /// `entries[k − k_lo][c]` = K at ℓ = α·2^k for channel c, as f32 bits, or `EMPTY`.
     entries: Vec<[AtomicU32; 3]>,
 }
 
@@ -148,11 +153,14 @@ impl LocalIntegralTable {
             unit: UnitDipole::new(d.albedo(), eta),
             limit: d.total_reflectance(),
         });
-        // Smallest power of two strictly above ℓ_min (2^−126 if ℓ_min is 0 or subnormal).
-        let k_lo = if ell_min < f32::MIN_POSITIVE {
+        // Smallest power of two strictly above ℓ_min/α (2^−126 if that is 0 or subnormal).
+        let ratio_min = ell_min / alpha;
+        let k_lo = if !(ratio_min >= f32::MIN_POSITIVE) {
             -126
+        } else if !ratio_min.is_finite() {
+            K_MAX
         } else {
-            (math::ilog2(ell_min) + 1).min(K_MAX)
+            (math::ilog2(ratio_min) + 1).min(K_MAX)
         };
         let entries = (k_lo..=K_MAX)
             .map(|_| [const { AtomicU32::new(EMPTY) }; 3])
@@ -161,6 +169,7 @@ impl LocalIntegralTable {
             channels,
             alpha,
             ell_min,
+            ratio_min,
             k_lo,
             entries,
         })
@@ -191,7 +200,8 @@ impl LocalIntegralTable {
         local_integral_unit(&self.channels[c].unit, self.alpha as f64 / ell as f64) as f32
     }
 
-    /// The cached K at ℓ = 2^k for channel c, computing it on first use.
+    /// The cached K at ℓ = α·2^k for channel c, computing it on first use. It depends on k
+    /// alone (a = α/ℓ = 2^−k), not on α: the table is scale invariant.
     #[inline]
     fn node(&self, c: usize, k: i32) -> f32 {
         let slot = &self.entries[(k - self.k_lo) as usize][c];
@@ -199,7 +209,7 @@ impl LocalIntegralTable {
         if bits != EMPTY {
             return f32::from_bits(bits);
         }
-        let v = self.exact_channel(c, math::pow2i(k));
+        let v = local_integral_unit(&self.channels[c].unit, libm::exp2(-k as f64)) as f32;
         slot.store(v.to_bits(), Ordering::Relaxed);
         v
     }
@@ -221,19 +231,23 @@ impl LocalIntegralTable {
         if !(ell > self.ell_min) || !ell.is_finite() {
             return limit;
         }
+        let ratio = ell / self.alpha;
+        if !ratio.is_finite() {
+            return self.node(c, K_MAX);
+        }
         let first = math::pow2i(self.k_lo);
-        if ell < first {
-            // Between ℓ_min and the first node: from the limit to K(2^k_lo).
-            let t = (ell - self.ell_min) / (first - self.ell_min);
+        if ratio < first {
+            // Between ℓ_min and the first node: from the limit to the first node.
+            let t = ((ratio - self.ratio_min) / (first - self.ratio_min)).clamp(0.0, 1.0);
             return limit + (self.node(c, self.k_lo) - limit) * t;
         }
-        let k = math::ilog2(ell).min(K_MAX);
+        let k = math::ilog2(ratio).min(K_MAX);
         let lo = self.node(c, k);
         if k == K_MAX {
             return lo;
         }
         let hi = self.node(c, k + 1);
-        let t = math::log2(ell) - k as f32; // ∈ [0, 1)
+        let t = math::log2(ratio) - k as f32; // ∈ [0, 1)
         if lo > 0.0 && hi > 0.0 {
             // Linear in log K over log ℓ: K = K_k · (K_k+1 / K_k)^t.
             lo * math::exp2(t * math::log2(hi / lo))
@@ -248,9 +262,10 @@ impl LocalIntegralTable {
         if !(ell_hi >= ell_lo) || !ell_hi.is_finite() || !(ell_hi > self.ell_min) {
             return;
         }
-        let lo = ell_lo.max(self.ell_min).max(f32::MIN_POSITIVE);
+        let lo = (ell_lo.max(self.ell_min) / self.alpha).max(f32::MIN_POSITIVE);
+        let hi = (ell_hi / self.alpha).min(f32::MAX);
         let k0 = math::ilog2(lo).max(self.k_lo);
-        let k1 = (math::ilog2(ell_hi) + 1).min(K_MAX);
+        let k1 = (math::ilog2(hi) + 1).min(K_MAX);
         for k in k0..=k1 {
             for c in 0..3 {
                 self.node(c, k);
@@ -258,7 +273,7 @@ impl LocalIntegralTable {
         }
     }
 
-    /// The exponents k whose nodes have been computed (in any channel), ascending.
+    /// The exponents k (nodes at ℓ = α·2^k) computed so far (in any channel), ascending.
     pub fn cached_exponents(&self) -> impl Iterator<Item = i32> + '_ {
         self.entries
             .iter()
@@ -369,17 +384,38 @@ mod tests {
     #[test]
     fn only_needed_powers_of_two_are_computed() {
         let p = profile(0.5, 1.3);
+        // α = 0.5: nodes at ℓ = 0.5·2^k.
         let table = LocalIntegralTable::new(&p, 0.5, 1e-3).unwrap();
         assert_eq!(table.cached_exponents().count(), 0);
-        table.lookup(Vec3::new(0.3, 0.3, 0.3)); // between 2^−2 and 2^−1
-        assert_eq!(table.cached_exponents().collect::<Vec<_>>(), [-2, -1]);
-        table.lookup(Vec3::splat(0.25)); // exactly a node: no new work beyond 2^−1
-        assert_eq!(table.cached_exponents().collect::<Vec<_>>(), [-2, -1]);
-        table.prefill(1.0, 3.0);
+        table.lookup(Vec3::new(0.3, 0.3, 0.3)); // ℓ/α = 0.6: between 2^−1 and 2^0
+        assert_eq!(table.cached_exponents().collect::<Vec<_>>(), [-1, 0]);
+        table.lookup(Vec3::splat(0.25)); // ℓ/α = 2^−1 exactly: no new work
+        assert_eq!(table.cached_exponents().collect::<Vec<_>>(), [-1, 0]);
+        table.prefill(1.0, 3.0); // ℓ/α from 2 to 6
         assert_eq!(
             table.cached_exponents().collect::<Vec<_>>(),
-            [-2, -1, 0, 1, 2]
+            [-1, 0, 1, 2, 3]
         );
+    }
+
+    /// The same material, α and ℓ in other units give the same K (nodes at ℓ/α = 2^k).
+    #[test]
+    fn table_is_scale_invariant() {
+        let p = profile(0.7, 1.3);
+        let reference = LocalIntegralTable::new(&p, 0.3, 0.3 / 1024.0).unwrap();
+        for scale in [1e-4_f32, 1e-2, 3.7, 1e3, 1e4] {
+            let table = LocalIntegralTable::new(&p, 0.3 * scale, 0.3 * scale / 1024.0).unwrap();
+            for ell in [1e-4_f32, 0.01, 0.1, 0.2, 0.31, 1.0, 7.0, 100.0] {
+                let (a, b) = (
+                    reference.lookup_channel(0, ell),
+                    table.lookup_channel(0, ell * scale),
+                );
+                assert!(
+                    (a - b).abs() <= 1e-5 * a,
+                    "scale {scale}, ℓ {ell}: {a} vs {b}"
+                );
+            }
+        }
     }
 
     /// The interpolation's maximum relative error against the exact K over
