@@ -304,18 +304,7 @@ fn render_in_pool(
 
     // Rasterise every object.
     let t = Instant::now();
-    let (near, far) = depth_range(&prep, camera);
-    let view_proj = camera.view_projection(near, far);
-    let mut visibility = VisibilityBuffer::new(camera.width, camera.height, settings.aa)
-        .map_err(RenderError::Raster)?;
-    for (i, object) in scene.objects.iter().enumerate() {
-        visibility.rasterize_mesh(
-            view_proj,
-            &object.mesh.positions,
-            &object.mesh.triangles,
-            prep.first_triangle[i],
-        );
-    }
+    let (visibility, view_proj) = rasterize(&prep)?;
     timings.raster = t.elapsed();
 
     // Shade.
@@ -399,6 +388,27 @@ fn render_in_pool(
             threads,
         },
     })
+}
+
+/// Rasterises every object of a prepared scene into the supersampled visibility buffer; also
+/// returns the world → clip transform used. Triangle ids are indices into
+/// [`Prepared::triangles`].
+pub fn rasterize(prep: &Prepared) -> Result<(VisibilityBuffer, glam::Mat4), RenderError> {
+    let scene = prep.scene;
+    let camera = &scene.camera;
+    let (near, far) = depth_range(prep, camera);
+    let view_proj = camera.view_projection(near, far);
+    let mut visibility = VisibilityBuffer::new(camera.width, camera.height, scene.render.aa)
+        .map_err(RenderError::Raster)?;
+    for (i, object) in scene.objects.iter().enumerate() {
+        visibility.rasterize_mesh(
+            view_proj,
+            &object.mesh.positions,
+            &object.mesh.triangles,
+            prep.first_triangle[i],
+        );
+    }
+    Ok((visibility, view_proj))
 }
 
 /// One shaded row and what it cost.
