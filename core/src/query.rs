@@ -214,11 +214,16 @@ impl IrradianceCache {
             return Err(QueryError::InvalidLocalIntegral);
         }
         settings.validate()?;
+        // N10's weights are scaled by 1/(Rd(0)·Ā) per channel (see `Params::local_scale`).
+        let centre = (profile.rd_zero().as_dvec3() * self.mean_area() as f64).to_array();
+        let local_scale =
+            centre.map(|c| (1.0 / c).clamp(f32::MIN_POSITIVE as f64, f32::MAX as f64) as f32);
         let params = Params {
             epsilon: settings.epsilon,
             cull_tolerance: settings.cull_tolerance,
             kernel: Kernel::new(settings.smoothing_radius),
             irradiance: point.irradiance,
+            local_scale,
         };
         let x = point.position;
         let e = point.irradiance;
@@ -246,8 +251,12 @@ impl IrradianceCache {
             Method::EdgeAware => {
                 let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
                 // N10: the shading point joins the kernel-weighted average at r = 0 with weight
-                // Rd(0)·Ā.
-                let centre = profile.rd_zero() * self.mean_area();
+                // Rd(0)·Ā, which is ≈ 1 in the scaled weights of the traversal.
+                let centre = Vec3::new(
+                    (centre[0] * local_scale[0] as f64) as f32,
+                    (centre[1] * local_scale[1] as f64) as f32,
+                    (centre[2] * local_scale[2] as f64) as f32,
+                );
                 let den = centre + sums.local_weight;
                 let e_loc = (centre * e + sums.local_flux) / den;
                 // With no weight at all (Ā = 0 and no samples within α) fall back to E(x).

@@ -451,3 +451,52 @@ fn empty_and_single_sample_caches() {
         assert!(m.total.is_finite() && m.total.min_element() >= 0.0);
     }
 }
+
+/// N10's weights Rd·A are scaled per channel by 1/(Rd(0)·Ā): where Rd(0)·Ā is far below f32's
+/// normal range (a sphere of radius 1e-9 with ℓ_u = 1e11: ~1e-44) the local irradiance must
+/// still match a double-precision evaluation of its formula (found by fuzzing: unscaled, the
+/// weights were subnormal and the ratio lost its digits).
+#[test]
+fn edge_aware_local_irradiance_stays_accurate_when_its_weights_are_tiny() {
+    let samples: Vec<lucent_core::Sample> = sphere_samples(2000, 1e-9, 21);
+    let cache = IrradianceCache::build(&samples).unwrap();
+    let p = profile(1e11);
+    let centre = p.rd_zero().as_dvec3() * cache.mean_area() as f64;
+    assert!(
+        centre.max_element() < 1e-38,
+        "the test needs subnormal weights, got {centre}"
+    );
+    let alpha = cache.smoothing_radius(3.0);
+    let kernel = lucent_core::Kernel::new(alpha);
+    let kk = LocalIntegralTable::new(&p, alpha, 0.0)
+        .unwrap()
+        .lookup(p.mean_free_path());
+    for x in query_points(60, 22) {
+        let x = x * 1e-9;
+        let e = Vec3::new(x.z.max(0.0) * 1e9, 0.2, 0.0);
+        // E_loc = [Rd(0) Ā E(x) + Σ w Rd A E] / [Rd(0) Ā + Σ w Rd A], in f64.
+        let (mut num, mut den) = (centre * e.as_dvec3(), centre);
+        for s in cache.samples() {
+            let r2 = (s.position - x).length_squared();
+            let wrd = p.rd(r2).as_dvec3() * kernel.weight(r2) as f64 * s.area as f64;
+            num += wrd * s.irradiance.as_dvec3();
+            den += wrd;
+        }
+        let want = (num / den).as_vec3();
+        let sp = ShadingPoint {
+            position: x,
+            irradiance: e,
+        };
+        let got = cache
+            .query(&p, &sp, kk, &settings(Method::EdgeAware, 0.0, 0.0, alpha))
+            .unwrap();
+        assert!(got.total.is_finite());
+        let error =
+            (got.local_irradiance - want).abs().max_element() / want.abs().max_element().max(1e-6);
+        assert!(
+            error < 1e-3,
+            "at {x}: E_loc {} vs {want}",
+            got.local_irradiance
+        );
+    }
+}

@@ -73,6 +73,8 @@ pub(crate) struct Params {
     pub kernel: Kernel,
     /// E(x): decides whether N10's deferred unlit subtrees matter.
     pub irradiance: Vec3,
+    /// N10: per channel 1/(Rd(0)·Ā) (clamped into the f32 range), the scale of its weights.
+    pub local_scale: [f32; 3],
 }
 
 /// What a traversal returns, per channel.
@@ -80,9 +82,9 @@ pub(crate) struct Params {
 pub(crate) struct Sums {
     /// Σ Rd·E·A (hierarchical) or Σ (1 − w)·Rd·E·A (split modes).
     pub global: Vec3,
-    /// N10: Σ w·Rd·E·A.
+    /// N10: Σ w·Rd·E·A, scaled by `Params::local_scale`.
     pub local_flux: Vec3,
-    /// N10: Σ w·Rd·A.
+    /// N10: Σ w·Rd·A, scaled by `Params::local_scale`.
     pub local_weight: Vec3,
 }
 
@@ -137,6 +139,7 @@ struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     cache: &'a IrradianceCache,
     profile: &'a Profile,
     kernel: Kernel,
+    local_scale: [f32; 3],
     x: [L; 3],
     /// Sample terms: r², flux r g b, area.
     samples: Buffer<5>,
@@ -209,11 +212,16 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         let one_minus_w = L::splat(1.0) - w;
         let area = area.keep(valid);
         for c in 0..3 {
-            let term = rd[c] * flux[c];
-            self.global[c] = self.global[c] + term * one_minus_w;
+            // The kernel factor multiplies the flux first: where it is 0, a term is 0 even if
+            // Rd·flux would overflow (∞·0 = NaN otherwise).
+            self.global[c] = self.global[c] + rd[c] * (flux[c] * one_minus_w);
             if MODE == EDGE_AWARE {
-                self.local_flux[c] = self.local_flux[c] + term * w;
-                self.local_weight[c] = self.local_weight[c] + rd[c] * area * w;
+                // N10's weights are scaled by 1/(Rd(0)·Ā) per channel, so that they are O(1)
+                // whatever the units (unscaled, Rd·A underflowed to subnormals at tiny scales
+                // and the local irradiance lost every digit).
+                let scaled = rd[c] * L::splat(self.local_scale[c]) * w;
+                self.local_flux[c] = self.local_flux[c] + scaled * flux[c];
+                self.local_weight[c] = self.local_weight[c] + scaled * area;
             }
         }
     }
@@ -484,6 +492,7 @@ pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
         cache,
         profile,
         kernel: params.kernel,
+        local_scale: params.local_scale,
         x: [L::splat(x.x), L::splat(x.y), L::splat(x.z)],
         samples: Buffer::new(),
         aggregates: Buffer::new(),
