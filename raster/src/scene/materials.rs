@@ -20,21 +20,11 @@ use super::model::{
 use super::origin::SceneOrigin;
 use crate::texture::{Texture, TextureEncoding};
 
-/// The measured materials of Jensen et al. 2001 (Table of σ_s′, σ_a in mm⁻¹, as carried by
-/// pbrt), accepted by `preset`, matched case-insensitively.
-pub const PRESET_NAMES: [&str; 11] = [
-    "apple",
-    "chicken1",
-    "chicken2",
-    "cream",
-    "ketchup",
-    "marble",
-    "potato",
-    "skimmilk",
-    "skin1",
-    "skin2",
-    "wholemilk",
-];
+/// The names accepted by `preset` (matched case-insensitively): the measured materials of
+/// Jensen et al. 2001 in `lucent_core::presets`, the one list.
+pub fn preset_names() -> impl Iterator<Item = &'static str> {
+    lucent_core::presets::PRESETS.iter().map(|p| p.name)
+}
 
 /// Material types accepted by `type`.
 const MATERIAL_TYPES: [&str; 2] = ["translucent", "lambert"];
@@ -227,8 +217,7 @@ fn build_medium(
     }
     if let Some(preset) = &m.preset {
         c.forbid(&key("eta"), &m.eta, "a preset (it has its own)")?;
-        let wanted = preset.get_ref().to_ascii_lowercase();
-        if !PRESET_NAMES.contains(&wanted.as_str()) {
+        if lucent_core::presets::find(preset.get_ref()).is_none() {
             return Err(c.at(
                 SceneErrorKind::UnknownName,
                 &key("preset"),
@@ -236,14 +225,17 @@ fn build_medium(
                 format!(
                     "unknown preset `{}` (expected one of: {})",
                     preset.get_ref(),
-                    PRESET_NAMES.join(", ")
+                    preset_names()
+                        .map(str::to_ascii_lowercase)
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             ));
         }
         let scale = c.require(&key("mm_per_unit"), &m.mm_per_unit, raw, "a preset")?;
         let mm_per_unit = c.positive(&key("mm_per_unit"), scale)?;
         let medium = Medium::Preset {
-            name: wanted,
+            name: preset.get_ref().to_ascii_lowercase(),
             mm_per_unit,
         };
         return Ok((medium, None));

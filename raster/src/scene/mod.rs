@@ -36,7 +36,7 @@ pub use default::{DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML, default_scene, default
 pub use error::{SceneError, SceneErrorKind};
 pub use lights::LIGHT_TYPES;
 pub use load::{MAX_SCENE_BYTES, load_scene, parse_scene};
-pub use materials::PRESET_NAMES;
+pub use materials::preset_names;
 pub use model::*;
 pub use objects::SHAPES;
 pub use origin::{MAX_FILE_BYTES, SceneOrigin};
