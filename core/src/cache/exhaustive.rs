@@ -32,14 +32,22 @@ pub fn exhaustive_sum_lanes<L: Lanes>(cache: &IrradianceCache, profile: &Profile
     total.as_vec3()
 }
 
-/// Per sample: (r², flux, area) in double precision.
-fn each_sample(cache: &IrradianceCache, x: Vec3, mut f: impl FnMut(f32, DVec3, f64)) {
+/// The split sums over every sample in double precision: (Σ (1 − w) Rd E A, Σ w Rd E A,
+/// Σ w Rd A) for the quartic kernel of radius α.
+fn split_sums(cache: &IrradianceCache, profile: &Profile, x: Vec3, alpha: f32) -> [DVec3; 3] {
+    let kernel = Kernel::new(alpha);
     let s = &cache.samples;
+    let mut sums = [DVec3::ZERO; 3];
     for i in 0..cache.len {
-        let p = Vec3::new(s.pos_x[i], s.pos_y[i], s.pos_z[i]);
+        let r2 = (Vec3::new(s.pos_x[i], s.pos_y[i], s.pos_z[i]) - x).length_squared();
         let flux = DVec3::new(s.flux_r[i] as f64, s.flux_g[i] as f64, s.flux_b[i] as f64);
-        f((p - x).length_squared(), flux, s.area[i] as f64);
+        let w = kernel.weight(r2) as f64;
+        let rd = profile.rd(r2).as_dvec3();
+        sums[0] += rd * flux * (1.0 - w);
+        sums[1] += rd * flux * w;
+        sums[2] += rd * s.area[i] as f64 * w;
     }
+    sums
 }
 
 /// The LM07 estimate with every sample evaluated, scalar, double-precision sums:
@@ -52,12 +60,7 @@ pub fn exhaustive_local_global(
     local_integral: Vec3,
     alpha: f32,
 ) -> Vec3 {
-    let kernel = Kernel::new(alpha);
-    let mut global = DVec3::ZERO;
-    each_sample(cache, x, |r2, flux, _| {
-        let w = kernel.weight(r2) as f64;
-        global += profile.rd(r2).as_dvec3() * flux * (1.0 - w);
-    });
+    let [global, _, _] = split_sums(cache, profile, x, alpha);
     (irradiance.as_dvec3() * local_integral.as_dvec3() + global).as_vec3()
 }
 
@@ -72,15 +75,7 @@ pub fn exhaustive_edge_aware(
     local_integral: Vec3,
     alpha: f32,
 ) -> Vec3 {
-    let kernel = Kernel::new(alpha);
-    let (mut global, mut num, mut den) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-    each_sample(cache, x, |r2, flux, area| {
-        let w = kernel.weight(r2) as f64;
-        let rd = profile.rd(r2).as_dvec3();
-        global += rd * flux * (1.0 - w);
-        num += rd * flux * w;
-        den += rd * area * w;
-    });
+    let [global, num, den] = split_sums(cache, profile, x, alpha);
     let centre = profile.rd_zero().as_dvec3() * cache.mean_area() as f64;
     let e_loc = (centre * irradiance.as_dvec3() + num) / (centre + den);
     let e_loc = DVec3::select(e_loc.is_finite_mask(), e_loc, irradiance.as_dvec3());
