@@ -21,9 +21,11 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// The kernel of radius α (α = 0 gives w ≡ 0: no smoothing).
+    /// The kernel of radius α (α = 0 gives w ≡ 0: no smoothing). So does an α whose square is
+    /// not a normal float (α < 1.1e-19): 1/α² would overflow and turn w(0) into ∞ · 0 = NaN;
+    /// such a kernel covers no distinct sample anyway.
     pub fn new(radius: f32) -> Self {
-        let radius = if radius.is_finite() && radius > 0.0 {
+        let radius = if radius.is_finite() && radius > 0.0 && radius * radius >= f32::MIN_POSITIVE {
             radius
         } else {
             0.0
@@ -92,7 +94,7 @@ mod tests {
             assert!((lanes[i] - k.weight(*r2)).abs() < 1e-7);
         }
         // α = 0 and nonsense radii switch smoothing off.
-        for bad in [0.0, -1.0, f32::NAN] {
+        for bad in [0.0, -1.0, f32::NAN, 1e-20] {
             let k = Kernel::new(bad);
             assert_eq!(k.weight(0.0), 0.0);
             assert_eq!(k.weight_lanes(ScalarLanes([0.0; 8])).to_array(), [0.0; 8]);
