@@ -119,6 +119,12 @@ def cache_seeds():
         for i in range(40):
             s += sample(0, (i * 3 - 60, (i * 7) % 50, -i), area_mode=2 if i % 3 else 0)
         write(t, name, s)
+    # Areas near the f32 limit, mostly unlit, a huge smoothing radius: N10's area-weighted
+    # sums overflow f32 (results need only be non-negative and NaN-free there).
+    big = cache_header(k=255, area=126, irr=-100, queries=((0, (255, 255, 255), u16(3)),))
+    for i in range(3):
+        big += sample(0, (i - 1, i, 0), irr_mode=2 if i == 0 else 0)
+    write(t, "huge-areas-unlit", big)
     # One sample; an empty set; an invalid (NaN) position; a non-finite shading point.
     write(t, "one-sample", cache_header() + sample(0, (1, 2, 3)))
     write(t, "empty", cache_header())

@@ -27,12 +27,14 @@
 //! 2. On success `validate()` holds and the cache holds every sample.
 //! 3. The profile (K_d, ℓ_u, η inside the documented valid ranges) and the local-integral
 //!    table build, and K is finite and non-negative.
-//! 4. Every method, with and without culling, returns finite (when the true sum is
-//!    representable in f32), non-negative, never NaN results; a non-finite shading point is
-//!    rejected with `NonFinitePosition`.
-//! 5. Culling with tolerance t skips at most t × the culled global sum, and never adds.
-//! 6. With ε = 0 and t = 0 the hierarchical, local-global and edge-aware queries equal the
-//!    exhaustive sums (core's oracles, and an independent scalar f64 sum) to float rounding.
+//! 4. Every method, with and without culling, returns non-negative, never NaN results, and
+//!    finite ones when every sum a query forms (flux or area-weighted) is bounded well inside
+//!    the f32 range; a non-finite shading point is rejected with `NonFinitePosition`.
+//! 5. (Bounded sums only, as in 4.) Culling with tolerance t skips at most t × the culled
+//!    global sum, and never adds.
+//! 6. (Likewise.) With ε = 0 and t = 0 the hierarchical, local-global and edge-aware queries
+//!    equal the exhaustive sums (core's oracles, and an independent scalar f64 sum) to float
+//!    rounding.
 //!
 //! Rounding allowance: every query sums non-negative terms in f32 lanes, each lane adding at
 //! most ⌈n/8⌉ + 16 terms, so the relative error is at most about (n/8 + 16)·2⁻²⁴ (the classical
@@ -250,12 +252,16 @@ pub fn cache_query_matches_exhaustive(data: &[u8]) {
         "K {k} for α {alpha}"
     );
 
-    // An upper bound of every sum a query forms (Rd ≤ Rd(0), w ≤ 1, K ≤ 1).
+    // An upper bound of every sum a query forms (Rd ≤ Rd(0), w ≤ 1, K ≤ 1, E(x) ≤ 4): the
+    // flux sums, and N10's area-weighted sums Σ w·Rd·A and Rd(0)·Ā.
     let rd0 = profile.rd_zero().as_dvec3();
     let bound: f64 = case
         .samples
         .iter()
-        .map(|s| (rd0 * (s.irradiance * s.area).as_dvec3()).max_element())
+        .map(|s| {
+            let flux = (rd0 * (s.irradiance * s.area).as_dvec3()).max_element();
+            flux + rd0.max_element() * f64::from(s.area)
+        })
         .sum::<f64>()
         + 4.0;
     let representable = bound < 1e36;

@@ -40,9 +40,10 @@ use lucent_raster::raster::{EMPTY, VisibilityBuffer};
 
 use super::input::{Input, pow2};
 
-/// Long thin buffers: `(width, height, aa)`, up to the 2^20 sub-samples per axis limit.
+/// Long thin buffers: `(width, height, aa)`, up to the 2^20 sub-samples per axis limit (kept
+/// to at most 2^20 sub-samples in all, so that an input costs milliseconds).
 const THIN_GRIDS: [(u32, u32, u32); 4] =
-    [(131_072, 1, 8), (1, 131_072, 8), (8192, 1, 8), (1, 4096, 4)];
+    [(1 << 20, 1, 1), (1, 1 << 20, 1), (4096, 1, 8), (1, 4096, 4)];
 
 /// Distance (in sub-samples) beyond which the margin oracle decides; snapping moves an edge
 /// by at most √2/512 ≈ 0.003 sub-sample.
