@@ -106,6 +106,14 @@ pub enum BuildError {
         /// The offending value.
         value: f32,
     },
+    /// The samples' total area or total flux (per channel) exceeds the f32 range, in which the
+    /// cache stores its node sums.
+    TotalOverflow {
+        /// Which total: "area" or "flux".
+        quantity: &'static str,
+        /// The total, summed in double precision.
+        total: f64,
+    },
     /// More samples than the 32-bit indices can address.
     TooManySamples {
         /// How many were given.
@@ -128,6 +136,12 @@ impl fmt::Display for BuildError {
             BuildError::InvalidIrradiance { index, value } => write!(
                 f,
                 "sample {index}: irradiance must be finite and non-negative, got {value}"
+            ),
+            BuildError::TotalOverflow { quantity, total } => write!(
+                f,
+                "the samples' total {quantity} {total:e} exceeds the single-precision range \
+                 (largest {:e}); scale the scene or the irradiance down",
+                f32::MAX
             ),
             BuildError::TooManySamples { count } => {
                 write!(

@@ -33,6 +33,7 @@ fn check(samples: &[Sample]) -> Result<(), BuildError> {
             count: samples.len(),
         });
     }
+    let (mut area, mut flux) = (0.0f64, DVec3::ZERO);
     for (index, s) in samples.iter().enumerate() {
         if !s.position.is_finite() {
             return Err(BuildError::NonFinitePosition { index });
@@ -48,13 +49,29 @@ fn check(samples: &[Sample]) -> Result<(), BuildError> {
                 return Err(BuildError::InvalidIrradiance { index, value });
             }
         }
-        let flux = s.irradiance * s.area;
-        if !flux.is_finite() {
+        let sample_flux = s.irradiance * s.area;
+        if !sample_flux.is_finite() {
             return Err(BuildError::InvalidIrradiance {
                 index,
-                value: flux.max_element(),
+                value: sample_flux.max_element(),
             });
         }
+        area += s.area as f64;
+        flux += sample_flux.as_dvec3();
+    }
+    // Node sums are f32: the root's must not overflow (every other node's is smaller).
+    let limit = f32::MAX as f64;
+    if area > limit {
+        return Err(BuildError::TotalOverflow {
+            quantity: "area",
+            total: area,
+        });
+    }
+    if flux.max_element() > limit {
+        return Err(BuildError::TotalOverflow {
+            quantity: "flux",
+            total: flux.max_element(),
+        });
     }
     Ok(())
 }
@@ -75,7 +92,8 @@ impl IrradianceCache {
     /// Builds a cache from irradiance samples (positions, areas, irradiance; any order).
     ///
     /// Errors on non-finite positions, negative or non-finite areas or irradiance (naming the
-    /// sample), and more than [`MAX_SAMPLES`] samples. An empty slice gives an empty cache.
+    /// sample), a total area or flux beyond the f32 range, and more than [`MAX_SAMPLES`]
+    /// samples. An empty slice gives an empty cache.
     pub fn build(input: &[Sample]) -> Result<IrradianceCache, BuildError> {
         check(input)?;
         let n = input.len();

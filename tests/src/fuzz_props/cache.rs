@@ -23,7 +23,8 @@
 //! # What is checked
 //!
 //! 1. `IrradianceCache::build` never panics; it fails exactly when a sample is invalid (a
-//!    non-finite position, a negative or non-finite area or irradiance, a non-finite flux).
+//!    non-finite position, a negative or non-finite area or irradiance, a non-finite flux) or
+//!    the total area or flux exceeds the f32 range.
 //! 2. On success `validate()` holds and the cache holds every sample.
 //! 3. The profile (K_d, ℓ_u, η inside the documented valid ranges) and the local-integral
 //!    table build, and K is finite and non-negative.
@@ -174,6 +175,16 @@ fn sample_is_valid(s: &Sample) -> bool {
         && (s.irradiance * s.area).is_finite()
 }
 
+/// The total area and flux, which the cache keeps in f32 node sums, must fit in f32.
+fn totals_fit_f32(samples: &[Sample]) -> bool {
+    let area: f64 = samples.iter().map(|s| f64::from(s.area)).sum();
+    let flux: DVec3 = samples
+        .iter()
+        .map(|s| (s.irradiance * s.area).as_dvec3())
+        .sum();
+    area.max(flux.max_element()) <= f64::from(f32::MAX)
+}
+
 /// M_o(x) = Σ Rd(|x − p_i|)·E_i·A_i over the input samples: scalar Rd, f64 sums.
 fn scalar_oracle(samples: &[Sample], profile: &Profile, x: Vec3) -> DVec3 {
     samples
@@ -220,7 +231,7 @@ fn assert_sane(what: &str, m: &Exitance, representable: bool) {
 pub fn cache_query_matches_exhaustive(data: &[u8]) {
     let case = decode(data);
     let n = case.samples.len();
-    let valid = case.samples.iter().all(sample_is_valid);
+    let valid = case.samples.iter().all(sample_is_valid) && totals_fit_f32(&case.samples);
     let cache = match (IrradianceCache::build(&case.samples), valid) {
         (Ok(cache), true) => cache,
         (Err(_), false) => return,
