@@ -2,8 +2,8 @@
 """Writes the hand-made seed corpus of every fuzz target into fuzz/corpus/<target>/seed-*.
 
 Run from anywhere: `python3 fuzz/make_seeds.py`. Seeds are named by what they exercise; the
-byte layouts are documented in tests/src/fuzz_props/*.rs. Minimised crashers (crash-*) and
-other committed inputs are left alone.
+byte layouts are documented in tests/src/fuzz_props/*.rs. Minimised inputs that found bugs
+(crash-*) or limitations (regress-*) are left alone.
 """
 import math
 import os
