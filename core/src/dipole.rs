@@ -129,7 +129,12 @@ fn check_positive(name: &'static str, v: f32) -> Result<(), ParamError> {
     }
 }
 
-/// Validates a relative index of refraction.
+/// Largest accepted relative index of refraction. J01's internal F_dr fit reaches 1 at
+/// η ≈ 3.85 (the boundary term A then diverges, and beyond it turns negative, making Rd
+/// negative); 3 keeps a margin and covers every translucent material (diamond is 2.42).
+pub const MAX_ETA: f32 = 3.0;
+
+/// Validates a relative index of refraction: finite, in [1, [`MAX_ETA`]].
 pub(crate) fn check_eta(eta: f32) -> Result<(), ParamError> {
     if !eta.is_finite() {
         Err(ParamError::NotFinite {
@@ -138,6 +143,8 @@ pub(crate) fn check_eta(eta: f32) -> Result<(), ParamError> {
         })
     } else if eta < 1.0 {
         Err(ParamError::EtaBelowOne { value: eta })
+    } else if eta > MAX_ETA {
+        Err(ParamError::EtaAboveMax { value: eta })
     } else {
         Ok(())
     }
@@ -666,6 +673,12 @@ mod tests {
             Dipole::from_coefficients(1.0, 1.0, 0.9),
             Err(ParamError::EtaBelowOne { .. })
         ));
+        // Above MAX_ETA the F_dr fit exceeds 1 (at η ≈ 3.85) and Rd would turn negative.
+        assert!(matches!(
+            Dipole::from_coefficients(1.0, 1.0, 4.0),
+            Err(ParamError::EtaAboveMax { .. })
+        ));
+        assert!(Dipole::from_coefficients(1.0, 1.0, MAX_ETA).is_ok());
         assert!(matches!(
             Dipole::from_coefficients(1.0, 1.0, f32::NAN),
             Err(ParamError::NotFinite { .. })

@@ -24,6 +24,12 @@ pub enum ParamError {
         /// The offending value.
         value: f32,
     },
+    /// A relative index of refraction above [`crate::dipole::MAX_ETA`], where the dipole's
+    /// Fresnel fit (and with it the profile) stops being valid.
+    EtaAboveMax {
+        /// The offending value.
+        value: f32,
+    },
     /// A diffuse reflectance K_d outside the open interval (0, 1).
     ReflectanceOutOfRange {
         /// The offending value.
@@ -56,6 +62,11 @@ impl fmt::Display for ParamError {
                     "eta (relative index of refraction) must be at least 1, got {value}"
                 )
             }
+            ParamError::EtaAboveMax { value } => write!(
+                f,
+                "eta (relative index of refraction) must be at most {}, got {value}",
+                crate::dipole::MAX_ETA
+            ),
             ParamError::ReflectanceOutOfRange { value } => {
                 write!(
                     f,

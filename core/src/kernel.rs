@@ -95,7 +95,7 @@ mod tests {
             assert!((lanes[i] - k.weight(*r2)).abs() < 1e-7);
         }
         // α = 0 and nonsense radii switch smoothing off.
-        for bad in [0.0, -1.0, f32::NAN] {
+        for bad in [0.0, -1.0, f32::NAN, 1e-20] {
             let k = Kernel::new(bad);
             assert_eq!(k.weight(0.0), 0.0);
             assert_eq!(k.weight_lanes(ScalarLanes([0.0; 8])).to_array(), [0.0; 8]);

@@ -172,6 +172,37 @@ fn bad_samples_are_typed_errors_naming_the_sample() {
     }
 }
 
+/// Each sample valid, but the f32 node sums would overflow: rejected, not built into a cache
+/// with infinite aggregates (found by the fuzz target `cache_query_matches_exhaustive`).
+#[test]
+fn totals_beyond_f32_are_typed_errors() {
+    let big = |x: f32, irradiance: f32| Sample {
+        position: Vec3::new(x, 0.0, 0.0),
+        area: 2e38,
+        irradiance: Vec3::splat(irradiance),
+    };
+    let err = IrradianceCache::build(&[big(0.0, 0.0), big(1.0, 0.0)]).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            BuildError::TotalOverflow {
+                quantity: "area",
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let small = |x: f32| Sample {
+        area: 1.0,
+        irradiance: Vec3::splat(2e38),
+        ..big(x, 0.0)
+    };
+    let err = IrradianceCache::build(&[small(0.0), small(1.0)]).unwrap_err();
+    assert!(err.to_string().contains("total flux"), "{err}");
+    let one = IrradianceCache::build(&[big(0.0, 0.0)]).unwrap();
+    one.validate().unwrap();
+}
+
 /// The memory budget: at most 64 bytes per sample, everything included.
 #[test]
 fn memory_per_sample_is_within_budget() {

@@ -52,15 +52,15 @@ fn check(samples: &[Sample]) -> Result<(), BuildError> {
                 return Err(BuildError::InvalidIrradiance { index, value });
             }
         }
-        let flux = s.irradiance * s.area;
-        if !flux.is_finite() {
+        let sample_flux = s.irradiance * s.area;
+        if !sample_flux.is_finite() {
             return Err(BuildError::InvalidIrradiance {
                 index,
-                value: flux.max_element(),
+                value: sample_flux.max_element(),
             });
         }
         total_area += s.area as f64;
-        total_flux += flux.as_dvec3();
+        total_flux += sample_flux.as_dvec3();
     }
     for (quantity, value) in [("area", total_area), ("flux", total_flux.max_element())] {
         if !(value as f32).is_finite() {
@@ -86,7 +86,8 @@ impl IrradianceCache {
     /// Builds a cache from irradiance samples (positions, areas, irradiance; any order).
     ///
     /// Errors on non-finite positions, negative or non-finite areas or irradiance (naming the
-    /// sample), and more than [`MAX_SAMPLES`] samples. An empty slice gives an empty cache.
+    /// sample), a total area or flux beyond the f32 range, and more than [`MAX_SAMPLES`]
+    /// samples. An empty slice gives an empty cache.
     pub fn build(input: &[Sample]) -> Result<IrradianceCache, BuildError> {
         check(input)?;
         let n = input.len();

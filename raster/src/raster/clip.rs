@@ -311,7 +311,12 @@ pub(crate) fn clip_and_project(clip: [Vec4; 3], grid: Grid) -> ScreenPolygon {
         return out;
     };
     let (cols, rows) = (f64::from(grid.cols), f64::from(grid.rows));
-    for p in poly.pos[..poly.n].iter().filter(|p| p.is_finite()) {
+    // A vertex of a polygon inside the square lies in [-1, 1]² up to rounding. One far outside
+    // is the intersection of two nearly parallel lines (e.g. coinciding near and far lines of
+    // a triangle seen edge-on), computed with an error larger than the polygon; clamping it
+    // would invent area, dropping it only shrinks the convex polygon.
+    let sane = |p: &&DVec2| p.is_finite() && p.x.abs() <= 1.0 + 1e-6 && p.y.abs() <= 1.0 + 1e-6;
+    for p in poly.pos[..poly.n].iter().filter(sane) {
         // Inside [-1, 1]² up to rounding; clamping removes the rounding.
         let (x, y) = (p.x.clamp(-1.0, 1.0), p.y.clamp(-1.0, 1.0));
         out.points[out.n] = FixedPoint {

@@ -310,7 +310,8 @@ fn build_medium(
     ))
 }
 
-/// The relative index of refraction: required, ≥ 1.
+/// The relative index of refraction: required, in [1, `lucent_core::dipole::MAX_ETA`] (the
+/// J01 Fresnel fit behind the dipole's boundary term is only sound there).
 fn eta(
     c: &Check,
     key: &str,
@@ -319,11 +320,12 @@ fn eta(
     what: &str,
 ) -> Checked<f32> {
     let v = c.require(key, v, table, what)?;
+    let max = lucent_core::dipole::MAX_ETA;
     c.num_where(
         key,
         v,
-        |x| x >= 1.0,
-        "must be at least 1 (relative index of refraction, inside / outside)",
+        |x| (1.0..=max).contains(&x),
+        &format!("must be between 1 and {max} (relative index of refraction, inside / outside)"),
     )
 }
 

@@ -60,7 +60,8 @@ fn material_values() {
         edit("mm_per_unit = 10", "mm_per_unit = 0") => "mm_per_unit", "material.m.mm_per_unit", "greater than 0";
         coeffs("[0.1, 0, 0.1]", "1", "1.3") => "sigma_a", "material.m.sigma_a", "greater than 0";
         coeffs("0.1", "-2", "1.3") => "sigma_s_prime", "material.m.sigma_s_prime", "greater than 0";
-        coeffs("0.1", "2", "0.9") => "eta", "material.m.eta", "at least 1";
+        coeffs("0.1", "2", "0.9") => "eta", "material.m.eta", "between 1 and 3";
+        coeffs("0.1", "2", "3.5") => "eta", "material.m.eta", "between 1 and 3";
         coeffs("0.1", "inf", "1.3") => "sigma_s_prime", "material.m.sigma_s_prime", "finite";
         coeffs("0.1", "2", "nan") => "eta", "material.m.eta", "finite";
         artist("[0.5, 1.0, 0.5]", "mean_free_path = 1") => "kd", "material.m.kd", "strictly between 0 and 1";

@@ -1,0 +1,40 @@
+//! The properties behind the fuzz targets in `fuzz/fuzz_targets/`.
+//!
+//! Each function takes the fuzzer's bytes and panics when its property fails. The fuzz targets
+//! are thin wrappers around them, and `tests/tests/fuzz_corpus.rs` replays every file of
+//! `fuzz/corpus/<target>/` through the same function, so that the committed seeds and
+//! minimised crashers run in `cargo test --workspace` without a fuzzer. See `docs/fuzzing.md`.
+//!
+//! | target | property |
+//! |---|---|
+//! | [`cache_query_matches_exhaustive`] | cache build/validate and every query method against the exhaustive sum |
+//! | [`table_lookup_finite`] | local-integral lookups finite, bounded by Rd_total, monotone in ℓ |
+//! | [`scene_parse_never_panics`] | arbitrary bytes → a scene or an error, a scene sound |
+//! | [`obj_load_never_panics`] | arbitrary bytes → a mesh or an error, a mesh valid |
+//! | [`raster_triangle_in_bounds`] | arbitrary clip-space triangles → coverage and depth as an oracle says |
+
+mod cache;
+pub mod input;
+mod parse;
+mod raster;
+mod table;
+
+pub use cache::{MAX_FUZZ_SAMPLES, cache_query_matches_exhaustive};
+pub use parse::{SMALL_MESH_OBJ, fuzz_origin, obj_load_never_panics, scene_parse_never_panics};
+pub use raster::raster_triangle_in_bounds;
+pub use table::table_lookup_finite;
+
+/// A property: takes the fuzzer's bytes, panics when the property fails.
+pub type Property = fn(&[u8]);
+
+/// Every target by name, with its property: what the replay test and tools iterate over.
+pub const TARGETS: [(&str, Property); 5] = [
+    (
+        "cache_query_matches_exhaustive",
+        cache_query_matches_exhaustive,
+    ),
+    ("table_lookup_finite", table_lookup_finite),
+    ("scene_parse_never_panics", scene_parse_never_panics),
+    ("obj_load_never_panics", obj_load_never_panics),
+    ("raster_triangle_in_bounds", raster_triangle_in_bounds),
+];
