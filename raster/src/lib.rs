@@ -12,6 +12,7 @@
 //! | lights and irradiance | [`lights`] |
 //! | shading through the core | [`material`], [`render`] |
 //! | PNG / EXR / PLY output, image comparison | [`output`] |
+//! | 2-D report drawing: charts, contact sheets | [`plot`] |
 //! | the `lucent` command | [`cli`] |
 
 pub mod camera;
@@ -20,6 +21,7 @@ pub mod geometry;
 pub mod lights;
 pub mod material;
 pub mod output;
+pub mod plot;
 pub mod raster;
 pub mod render;
 pub mod sampling;

@@ -1,0 +1,403 @@
+//! [`Canvas`]: an opaque 8-bit RGB drawing surface over a `tiny_skia::Pixmap`.
+//!
+//! Lines and circles are anti-aliased `tiny-skia` paths; rectangles are filled without
+//! anti-aliasing so that frames and grid lines stay crisp; text is the [`font`]
+//! enlarged to whole-pixel blocks; images are copied pixel for pixel. All colours are opaque
+//! sRGB bytes, so the canvas stays opaque and [`Canvas::to_rgb8`] is exact.
+//!
+//! Drawing never fails and never panics: shapes are clipped to the canvas, and non-finite
+//! coordinates or non-positive sizes draw nothing. Only construction and image copies, which
+//! can be handed inconsistent sizes, return a [`PlotError`].
+//!
+//! [`crop_magnify`] cuts a rectangle out of an RGB image and enlarges it by pixel
+//! replication, for the magnified insets of a contact sheet.
+
+use std::path::Path;
+
+use tiny_skia::{Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke};
+use tiny_skia::{PremultipliedColorU8, Transform};
+
+use super::{PlotError, check_rgb_len, font};
+use crate::output::OutputError;
+use crate::output::png::write_png_rgb8;
+
+/// The largest width or height, in pixels, of a canvas or of an image made by this module.
+pub const MAX_SIDE: u32 = 16384;
+
+/// An opaque RGB image to draw on. See the [module documentation](self).
+#[derive(Debug, Clone)]
+pub struct Canvas {
+    pixmap: Pixmap,
+}
+
+impl Canvas {
+    /// A `width × height` canvas filled with `background`.
+    ///
+    /// Fails with [`PlotError::Size`] when a side is 0 or larger than [`MAX_SIDE`].
+    pub fn new(width: u32, height: u32, background: [u8; 3]) -> Result<Self, PlotError> {
+        let size_error = PlotError::Size {
+            width: width.into(),
+            height: height.into(),
+        };
+        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+            return Err(size_error);
+        }
+        let mut pixmap = Pixmap::new(width, height).ok_or(size_error)?;
+        pixmap.fill(color(background));
+        Ok(Canvas { pixmap })
+    }
+
+    /// The width in pixels.
+    pub fn width(&self) -> u32 {
+        self.pixmap.width()
+    }
+
+    /// The height in pixels.
+    pub fn height(&self) -> u32 {
+        self.pixmap.height()
+    }
+
+    /// The colour of the pixel at (`x`, `y`), or `None` outside the canvas.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<[u8; 3]> {
+        let p = self.pixmap.pixel(x, y)?.demultiply();
+        Some([p.red(), p.green(), p.blue()])
+    }
+
+    /// Fills the rectangle with corners (`x`, `y`) and (`x + w`, `y + h`) with `rgb`.
+    ///
+    /// Not anti-aliased: a pixel is covered when its centre is inside, so rectangles on whole
+    /// pixel coordinates are exact. Draws nothing for non-finite values or `w, h ≤ 0`; the
+    /// corners may otherwise be anywhere.
+    pub fn fill_rect(&mut self, x: f32, y: f32, w: f32, h: f32, rgb: [u8; 3]) {
+        let finite = x.is_finite() && y.is_finite() && w.is_finite() && h.is_finite();
+        if !(finite && w > 0.0 && h > 0.0) {
+            return;
+        }
+        // Clip to a little more than the canvas first, so that huge rectangles stay in the
+        // range where tiny-skia's fixed-point arithmetic is exact.
+        let limit_x = self.width() as f32 + 1.0;
+        let limit_y = self.height() as f32 + 1.0;
+        let (left, right) = (x.max(-1.0), (x + w).min(limit_x));
+        let (top, bottom) = (y.max(-1.0), (y + h).min(limit_y));
+        let Some(rect) = Rect::from_ltrb(left, top, right, bottom) else {
+            return;
+        };
+        let mut paint = paint(rgb);
+        paint.anti_alias = false;
+        self.pixmap
+            .fill_rect(rect, &paint, Transform::identity(), None);
+    }
+
+    /// Draws the outline of a rectangle, `line_width` pixels thick, inside the rectangle
+    /// with corners (`x`, `y`) and (`x + w`, `y + h`). Like [`fill_rect`](Self::fill_rect),
+    /// not anti-aliased.
+    pub fn stroke_rect(&mut self, x: f32, y: f32, w: f32, h: f32, rgb: [u8; 3], line_width: f32) {
+        if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0 && line_width > 0.0) {
+            return;
+        }
+        let t = line_width.min(w / 2.0).min(h / 2.0);
+        self.fill_rect(x, y, w, t, rgb);
+        self.fill_rect(x, y + h - t, w, t, rgb);
+        self.fill_rect(x, y + t, t, h - 2.0 * t, rgb);
+        self.fill_rect(x + w - t, y + t, t, h - 2.0 * t, rgb);
+    }
+
+    /// Draws an anti-aliased line `line_width` pixels wide through `points`, with round
+    /// joins and caps.
+    ///
+    /// A non-finite point breaks the line: the parts before and after it are drawn
+    /// separately. Segments are clipped to the neighbourhood of the canvas, so far-away
+    /// points keep the direction of the visible part. Fewer than two usable points, or a
+    /// width that is not positive, draw nothing; widths beyond `4 · MAX_SIDE` are treated as
+    /// `4 · MAX_SIDE`.
+    pub fn stroke_polyline(&mut self, points: &[(f32, f32)], rgb: [u8; 3], line_width: f32) {
+        if !(line_width > 0.0) {
+            return;
+        }
+        let line_width = line_width.min(4.0 * MAX_SIDE as f32);
+        let margin = line_width / 2.0 + 2.0;
+        let bounds = (
+            -margin,
+            -margin,
+            self.width() as f32 + margin,
+            self.height() as f32 + margin,
+        );
+        let mut builder = PathBuilder::new();
+        let mut pen: Option<(f32, f32)> = None;
+        for pair in points.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let finite = |p: (f32, f32)| p.0.is_finite() && p.1.is_finite();
+            if !finite(a) || !finite(b) {
+                pen = None;
+                continue;
+            }
+            let Some((from, to)) = clip_segment(a, b, bounds) else {
+                pen = None;
+                continue;
+            };
+            if pen != Some(from) {
+                builder.move_to(from.0, from.1);
+            }
+            builder.line_to(to.0, to.1);
+            // The next segment continues this sub-path only when it was not clipped here.
+            pen = (to == b).then_some(to);
+        }
+        let Some(path) = builder.finish() else {
+            return;
+        };
+        let stroke = Stroke {
+            width: line_width,
+            line_cap: LineCap::Round,
+            line_join: LineJoin::Round,
+            ..Stroke::default()
+        };
+        self.pixmap
+            .stroke_path(&path, &paint(rgb), &stroke, Transform::identity(), None);
+    }
+
+    /// Fills an anti-aliased disc of radius `r` centred on (`cx`, `cy`). Draws nothing for
+    /// non-finite values, `r ≤ 0`, or a disc entirely outside the canvas.
+    pub fn circle(&mut self, cx: f32, cy: f32, r: f32, rgb: [u8; 3]) {
+        if !(r > 0.0 && r.is_finite() && cx.is_finite() && cy.is_finite()) {
+            return;
+        }
+        let (w, h) = (self.width() as f32, self.height() as f32);
+        if cx + r < 0.0 || cy + r < 0.0 || cx - r > w || cy - r > h {
+            return;
+        }
+        if (cx - r <= -1.0 && cx + r >= w + 1.0 && cy - r <= -1.0 && cy + r >= h + 1.0)
+            && [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+                .iter()
+                .all(|&(x, y)| (x - cx).hypot(y - cy) <= r - 1.0)
+        {
+            // The disc covers the whole canvas (a path this big may be beyond tiny-skia's
+            // fixed-point range).
+            self.pixmap.fill(color(rgb));
+            return;
+        }
+        let Some(path) = PathBuilder::from_circle(cx, cy, r) else {
+            return;
+        };
+        self.pixmap.fill_path(
+            &path,
+            &paint(rgb),
+            FillRule::Winding,
+            Transform::identity(),
+            None,
+        );
+    }
+
+    /// Writes `text` with its top-left corner at (`x`, `y`), every font pixel enlarged to a
+    /// `scale × scale` block (see [`font`]). The text is [`font::text_width`]
+    /// wide and [`font::text_height`] tall; whatever falls outside the canvas is clipped.
+    pub fn text(&mut self, x: i32, y: i32, text: &str, scale: u32, rgb: [u8; 3]) {
+        let s = i64::from(scale);
+        for (u, v) in font::ink(text) {
+            let left = i64::from(x).saturating_add((u as i64).saturating_mul(s));
+            let top = i64::from(y) + i64::from(v) * s;
+            self.fill_block(left, top, s, s, rgb);
+        }
+    }
+
+    /// Writes `text` rotated 90° counter-clockwise (reading from bottom to top, as on a
+    /// y-axis label), with the top-left corner of its bounding box at (`x`, `y`). The box is
+    /// [`font::text_height`] wide and [`font::text_width`] tall; it is clipped like
+    /// [`text`](Self::text).
+    pub fn text_vertical(&mut self, x: i32, y: i32, text: &str, scale: u32, rgb: [u8; 3]) {
+        let s = i64::from(scale);
+        let cells = text.chars().count() as i64;
+        let length = (cells * i64::from(font::ADVANCE) - i64::from(font::SPACING)).max(0);
+        for (u, v) in font::ink(text) {
+            // Text column u becomes row (length − 1 − u); text row v becomes column v.
+            let row = (length - 1 - u as i64).saturating_mul(s);
+            let top = i64::from(y).saturating_add(row);
+            self.fill_block(i64::from(x) + i64::from(v) * s, top, s, s, rgb);
+        }
+    }
+
+    /// Copies an 8-bit RGB image (`width × height` pixels, row-major, 3 bytes per pixel)
+    /// with its top-left corner at (`x`, `y`), clipped to the canvas.
+    ///
+    /// Fails with [`PlotError::BufferLength`] when `rgb` does not hold `3 · width · height`
+    /// bytes; nothing is drawn then.
+    pub fn blit_rgb8(
+        &mut self,
+        x: i32,
+        y: i32,
+        width: u32,
+        height: u32,
+        rgb: &[u8],
+    ) -> Result<(), PlotError> {
+        check_rgb_len(width, height, rgb)?;
+        let (canvas_w, canvas_h) = (i64::from(self.width()), i64::from(self.height()));
+        let (x, y) = (i64::from(x), i64::from(y));
+        // Source columns and rows that land on the canvas.
+        let col0 = (-x).clamp(0, i64::from(width));
+        let col1 = (canvas_w - x).clamp(col0, i64::from(width));
+        let row0 = (-y).clamp(0, i64::from(height));
+        let row1 = (canvas_h - y).clamp(row0, i64::from(height));
+        let run = (col1 - col0) as usize * 3;
+        let data = self.pixmap.data_mut();
+        for row in row0..row1 {
+            let src = (row as usize * width as usize + col0 as usize) * 3;
+            let dst = (((y + row) * canvas_w + x + col0) * 4) as usize;
+            let source = rgb[src..src + run].chunks_exact(3);
+            let target = data[dst..dst + run / 3 * 4].chunks_exact_mut(4);
+            for (out, pixel) in target.zip(source) {
+                out.copy_from_slice(&[pixel[0], pixel[1], pixel[2], 255]);
+            }
+        }
+        Ok(())
+    }
+
+    /// The canvas as 8-bit RGB bytes, row-major, top row first.
+    pub fn to_rgb8(&self) -> Vec<u8> {
+        let mut bytes = Vec::with_capacity(self.pixmap.pixels().len() * 3);
+        for p in self.pixmap.pixels() {
+            let c = p.demultiply();
+            bytes.extend_from_slice(&[c.red(), c.green(), c.blue()]);
+        }
+        bytes
+    }
+
+    /// Writes the canvas as an 8-bit RGB PNG, atomically (see
+    /// [`write_png_rgb8`]).
+    pub fn write_png(&self, path: &Path) -> Result<(), OutputError> {
+        write_png_rgb8(path, self.width(), self.height(), &self.to_rgb8())
+    }
+
+    /// Sets the pixels of the rectangle at (`x`, `y`) of `w × h` pixels, clipped.
+    fn fill_block(&mut self, x: i64, y: i64, w: i64, h: i64, rgb: [u8; 3]) {
+        let (canvas_w, canvas_h) = (i64::from(self.width()), i64::from(self.height()));
+        let (x0, x1) = (x.clamp(0, canvas_w), x.saturating_add(w).clamp(0, canvas_w));
+        let (y0, y1) = (y.clamp(0, canvas_h), y.saturating_add(h).clamp(0, canvas_h));
+        let pixel = PremultipliedColorU8::from_rgba(rgb[0], rgb[1], rgb[2], 255);
+        let Some(pixel) = pixel else {
+            return; // Unreachable: an opaque colour is always a valid premultiplied one.
+        };
+        let pixels = self.pixmap.pixels_mut();
+        for row in y0..y1 {
+            let start = (row * canvas_w) as usize;
+            pixels[start + x0 as usize..start + x1 as usize].fill(pixel);
+        }
+    }
+}
+
+/// The opaque tiny-skia colour of `rgb`.
+fn color(rgb: [u8; 3]) -> Color {
+    Color::from_rgba8(rgb[0], rgb[1], rgb[2], 255)
+}
+
+/// An anti-aliased solid paint of `rgb`.
+fn paint(rgb: [u8; 3]) -> Paint<'static> {
+    let mut paint = Paint::default();
+    paint.set_color(color(rgb));
+    paint.anti_alias = true;
+    paint
+}
+
+/// Clips the segment `a`–`b` to the rectangle `(left, top, right, bottom)` (Liang–Barsky);
+/// `None` when no part of it is inside. A clipped end is put exactly on the edge that cut
+/// it, which keeps very long segments (whose parameter along the segment is imprecise)
+/// accurate across the canvas.
+pub(super) fn clip_segment(
+    a: (f32, f32),
+    b: (f32, f32),
+    (left, top, right, bottom): (f32, f32, f32, f32),
+) -> Option<((f32, f32), (f32, f32))> {
+    // Work in f64: the coordinates may be up to f32::MAX and their differences overflow f32.
+    let (ax, ay, bx, by) = (a.0 as f64, a.1 as f64, b.0 as f64, b.1 as f64);
+    let (dx, dy) = (bx - ax, by - ay);
+    // The parameter of each end along a→b, and the edge that cut it: (is_vertical, position).
+    let mut start: (f64, Option<(bool, f64)>) = (0.0, None);
+    let mut end: (f64, Option<(bool, f64)>) = (1.0, None);
+    for (p, q, edge) in [
+        (-dx, ax - left as f64, (true, left as f64)),
+        (dx, right as f64 - ax, (true, right as f64)),
+        (-dy, ay - top as f64, (false, top as f64)),
+        (dy, bottom as f64 - ay, (false, bottom as f64)),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None; // Parallel to this edge and outside it.
+            }
+        } else {
+            let t = q / p;
+            if p < 0.0 && t > start.0 {
+                start = (t, Some(edge));
+            } else if p > 0.0 && t < end.0 {
+                end = (t, Some(edge));
+            }
+        }
+    }
+    if start.0 > end.0 {
+        return None;
+    }
+    let point = |(_, edge): (f64, Option<(bool, f64)>), endpoint: (f32, f32)| match edge {
+        None => endpoint,
+        // A vertical edge cuts only segments with dx ≠ 0, a horizontal one only dy ≠ 0.
+        Some((true, x)) => (x as f32, (ay + (x - ax) * (dy / dx)) as f32),
+        Some((false, y)) => ((ax + (y - ay) * (dx / dy)) as f32, y as f32),
+    };
+    Some((point(start, a), point(end, b)))
+}
+
+/// Cuts the rectangle at (`x0`, `y0`) of `w × h` pixels out of an 8-bit RGB image of
+/// `width × height` pixels and enlarges it `factor` times by pixel replication (nearest
+/// neighbour). Returns the crop's bytes, width and height.
+///
+/// The rectangle is clamped to the image, so the crop may be smaller than `w × h`. Fails
+/// when `rgb` has the wrong length ([`PlotError::BufferLength`]), `factor` is 0
+/// ([`PlotError::ZeroFactor`]), the clamped rectangle is empty ([`PlotError::EmptyCrop`]), or
+/// the enlarged crop would have a side longer than [`MAX_SIDE`] ([`PlotError::Size`]).
+pub fn crop_magnify(
+    rgb: &[u8],
+    width: u32,
+    height: u32,
+    x0: u32,
+    y0: u32,
+    w: u32,
+    h: u32,
+    factor: u32,
+) -> Result<(Vec<u8>, u32, u32), PlotError> {
+    check_rgb_len(width, height, rgb)?;
+    if factor == 0 {
+        return Err(PlotError::ZeroFactor);
+    }
+    let crop_w = x0.saturating_add(w).min(width).saturating_sub(x0);
+    let crop_h = y0.saturating_add(h).min(height).saturating_sub(y0);
+    if crop_w == 0 || crop_h == 0 {
+        return Err(PlotError::EmptyCrop {
+            x0,
+            y0,
+            w,
+            h,
+            width,
+            height,
+        });
+    }
+    let out_w = u64::from(crop_w) * u64::from(factor);
+    let out_h = u64::from(crop_h) * u64::from(factor);
+    if out_w > u64::from(MAX_SIDE) || out_h > u64::from(MAX_SIDE) {
+        return Err(PlotError::Size {
+            width: out_w,
+            height: out_h,
+        });
+    }
+    let (out_w, out_h) = (out_w as usize, out_h as usize);
+    let mut out = Vec::with_capacity(out_w * out_h * 3);
+    let mut line = Vec::with_capacity(out_w * 3);
+    for row in 0..crop_h as usize {
+        line.clear();
+        let start = ((y0 as usize + row) * width as usize + x0 as usize) * 3;
+        for pixel in rgb[start..start + crop_w as usize * 3].chunks_exact(3) {
+            for _ in 0..factor {
+                line.extend_from_slice(pixel);
+            }
+        }
+        for _ in 0..factor {
+            out.extend_from_slice(&line);
+        }
+    }
+    Ok((out, out_w as u32, out_h as u32))
+}
