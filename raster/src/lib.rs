@@ -13,8 +13,10 @@
 //! | shading through the core | [`material`], [`render`] |
 //! | PNG / EXR / PLY output, image comparison | [`output`] |
 //! | 2-D report drawing: charts, contact sheets | [`plot`] |
+//! | run time against error: `lucent bench` | [`bench`] |
 //! | the `lucent` command | [`cli`] |
 
+pub mod bench;
 pub mod camera;
 pub mod cli;
 pub mod geometry;

@@ -5,11 +5,9 @@ use std::path::Path;
 
 use lucent_core::{Profile, presets};
 
-use super::{BakeArgs, CompareArgs, MethodArg, RenderArgs};
-use crate::output::{
-    ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, compare as compare_images, error_heatmap,
-    read_exr_rgb, read_png, write_exr, write_png,
-};
+use super::{BakeArgs, BenchArgs, MethodArg, RenderArgs};
+use crate::bench::{self, BenchConfig, BenchScene};
+use crate::output::{write_exr, write_png};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
     MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, Scene, SssMethod, default_scene, load_scene,
@@ -291,59 +289,47 @@ pub fn presets() -> Result<(), String> {
     Ok(())
 }
 
-fn read_image(path: &Path) -> Result<RgbImage, String> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "png" => read_png(path).map_err(|e| e.to_string()),
-        "exr" => read_exr_rgb(path).map_err(|e| e.to_string()),
-        _ => Err(format!(
-            "{}: unknown image type (expected .exr or .png)",
-            path.display()
-        )),
+/// `lucent bench`.
+pub fn bench(args: &BenchArgs) -> Result<(), String> {
+    let mut config = if args.quick {
+        BenchConfig::quick()
+    } else {
+        BenchConfig::full()
+    };
+    if !args.scenes.is_empty() {
+        config.scenes = args
+            .scenes
+            .iter()
+            .map(|name| {
+                BenchScene::from_name(name).ok_or_else(|| {
+                    format!(
+                        "--scenes: unknown scene '{name}' (expected default, sphere or textured)"
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()?;
     }
-}
-
-/// `lucent compare`.
-pub fn compare(args: &CompareArgs) -> Result<(), String> {
-    let test = read_image(&args.test)?;
-    let reference = read_image(&args.reference)?;
-    let stats = compare_images(&test, &reference, None).map_err(|e| e.to_string())?;
-    println!("pixels            {}", stats.pixels);
-    println!("RMSE              {:.6e}", stats.rmse);
-    println!("mean |error|      {:.6e}", stats.mean_abs);
-    println!("mean relative L1  {:.6e}", stats.mean_relative_l1);
-    println!(
-        "max |error|       {:.6e} at ({}, {}) channel {}",
-        stats.max_abs,
-        stats.max_abs_at.0,
-        stats.max_abs_at.1,
-        ["R", "G", "B"][stats.max_abs_channel]
-    );
-    if let Some(out) = &args.heatmap {
-        let options = HeatmapOptions {
-            metric: if args.relative {
-                ErrorMetric::Relative
-            } else {
-                ErrorMetric::Absolute
-            },
-            scale: if args.log {
-                HeatmapScale::Log { decades: 4.0 }
-            } else {
-                HeatmapScale::Linear
-            },
-            max: None,
-        };
-        let map = error_heatmap(&test, &reference, None, &options).map_err(|e| e.to_string())?;
-        map.write_png(out).map_err(|e| e.to_string())?;
-        println!(
-            "heat map          {} (white = {:.3e})",
-            out.display(),
-            map.white
-        );
+    if !args.counts.is_empty() {
+        config.counts = args.counts.clone();
+        if !config.counts.contains(&config.sheet_count) {
+            config.sheet_count = config.counts[config.counts.len() / 2];
+        }
     }
+    if let Some(n) = args.seeds {
+        check((1..=16).contains(&n), "--seeds", n, "1 to 16")?;
+        config.seeds = (1..=u64::from(n)).collect();
+    }
+    if let Some(r) = args.resolution {
+        config.resolution = r;
+        config.end_to_end &= r == 512;
+    }
+    config.threads = args.threads;
+    let quiet = args.quiet;
+    bench::run(&config, &args.output, &mut |line| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    })
+    .map_err(|e| format!("bench: {e}"))?;
     Ok(())
 }

@@ -1,9 +1,10 @@
-//! The `lucent` command line: `render` (the default), `bake`, `presets`, `compare`.
+//! The `lucent` command line: `render` (the default), `bake`, `presets`, `compare`, `bench`.
 //!
 //! Exit codes: 0 success, 1 a runtime error (bad scene, missing file, …; the message names the
 //! problem), 2 a usage error (unknown flag, malformed value; printed by clap).
 
 mod commands;
+mod compare;
 
 use std::path::PathBuf;
 
@@ -40,7 +41,13 @@ pub enum Command {
     Bake(BakeArgs),
     /// List the measured materials (Jensen et al. 2001) usable as `preset = "…"`.
     Presets,
-    /// Compare two images (OpenEXR or PNG): RMSE, mean relative error, maximum error.
+    /// Run time against error: render the benchmark scenes at several sample counts with
+    /// every method, measure time, memory and error against a ground truth, and write a
+    /// report folder (Markdown, CSV, plots, Figure-1 contact sheets).
+    Bench(BenchArgs),
+    /// Compare two images (OpenEXR or PNG): RMSE, mean relative error, maximum error, over all
+    /// pixels and, from the reference EXR's exitance and irradiance layers, over the
+    /// translucent pixels and the band around shadow edges; optionally seed noise.
     Compare(CompareArgs),
 }
 
@@ -134,6 +141,35 @@ pub struct BakeArgs {
     pub quiet: bool,
 }
 
+/// Options of `bench`.
+#[derive(Debug, Args, Clone)]
+pub struct BenchArgs {
+    /// Where to write the report (report.md, results.csv, PNG plots and sheets).
+    #[arg(short, long, value_name = "DIR", default_value = "bench-report")]
+    pub output: PathBuf,
+    /// A small version (96², two sample counts) that finishes in well under a minute.
+    #[arg(long)]
+    pub quick: bool,
+    /// Only these scenes (default, sphere, textured), comma-separated.
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    pub scenes: Vec<String>,
+    /// Sample counts instead of the preset's, comma-separated.
+    #[arg(long, value_delimiter = ',', value_name = "N,N,...")]
+    pub counts: Vec<u32>,
+    /// Seeds per configuration (the noise needs two or more).
+    #[arg(long, value_name = "N")]
+    pub seeds: Option<u32>,
+    /// Image width and height.
+    #[arg(long, value_name = "PIXELS")]
+    pub resolution: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
 /// Options of `compare`.
 #[derive(Debug, Args, Clone)]
 pub struct CompareArgs {
@@ -150,6 +186,10 @@ pub struct CompareArgs {
     /// Heat map on a logarithmic scale (4 decades).
     #[arg(long)]
     pub log: bool,
+    /// Also report seed noise: the per-pixel standard deviation across TEST and these renders
+    /// of the same scene with other sample seeds.
+    #[arg(long, value_name = "IMAGE", num_args = 1..)]
+    pub noise_with: Vec<PathBuf>,
 }
 
 /// Runs the command line and returns the process exit code.
@@ -167,7 +207,8 @@ pub fn main() -> i32 {
         Some(Command::Render(args)) => commands::render(&args),
         Some(Command::Bake(args)) => commands::bake(&args),
         Some(Command::Presets) => commands::presets(),
-        Some(Command::Compare(args)) => commands::compare(&args),
+        Some(Command::Compare(args)) => compare::compare(&args),
+        Some(Command::Bench(args)) => commands::bench(&args),
     };
     match result {
         Ok(()) => 0,

@@ -83,6 +83,10 @@ pub struct RenderOptions<'a> {
     pub collect_stats: bool,
     /// Compute K by quadrature at every shading point instead of the power-of-two table.
     pub exact_local_integral: bool,
+    /// Compute the irradiance at every translucent shading point, even for the methods that
+    /// do not need it (hierarchical, exhaustive), so that the irradiance layer is complete.
+    /// Implied when the scene asks for the `irradiance` EXR layer.
+    pub irradiance_layer: bool,
 }
 
 /// Wall-clock time per phase.
@@ -320,6 +324,7 @@ fn render_in_pool(
             smoothing_radius: 0.0,
         },
         exact_local_integral: options.exact_local_integral,
+        irradiance_everywhere: options.irradiance_layer || scene.output.layers.irradiance,
         camera,
         view_proj,
         visibility: &visibility,

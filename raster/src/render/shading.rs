@@ -73,6 +73,9 @@ pub struct Shading<'a> {
     /// Use a fresh quadrature for K at every point instead of the table (for measuring the
     /// table's error).
     pub exact_local_integral: bool,
+    /// Compute E(x) at translucent points even when the method does not use it (for the
+    /// irradiance layer).
+    pub irradiance_everywhere: bool,
     /// The camera.
     pub camera: &'a Camera,
     /// World → clip.
@@ -163,7 +166,7 @@ impl Shading<'_> {
                 let method = self.settings.method;
                 let mut e = Vec3::ZERO;
                 let mut highlight = Vec3::ZERO;
-                if method.is_split() || shader.specular.is_some() {
+                if method.is_split() || shader.specular.is_some() || self.irradiance_everywhere {
                     self.lighting.for_each(position, normal, seed, |incident| {
                         e += incident.irradiance;
                         if let Some(spec) = shader.specular {

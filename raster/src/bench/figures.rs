@@ -1,0 +1,284 @@
+//! The benchmark's pictures: per scene an error-against-time chart (overall and in the
+//! shadow-edge band) and a contact sheet laid out like Figure 1 of Neulander 2010.
+//!
+//! ```text
+//!               no smoothing   LM07   edge-aware   ground truth
+//! image            ▢            ▢         ▢             ▢        (inset marked in yellow)
+//! shadow edge ×3   ▢            ▢         ▢             ▢
+//! error            ▢            ▢         ▢                      (relative, log scale,
+//! error ×3         ▢            ▢         ▢                       one white level per sheet)
+//! ```
+
+use std::path::Path;
+
+use super::runner::{MethodSetting, Reference};
+use super::{BenchConfig, BenchError, BenchReport, BenchScene};
+use crate::output::png::encode_srgb8;
+use crate::output::{ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, error_heatmap};
+use crate::plot::{Chart, Series, Sheet, SheetRow, Tile, crop_magnify, render_chart, render_sheet};
+use crate::scene::SssMethod;
+
+/// Magnification of the shadow-edge insets.
+const INSET_ZOOM: u32 = 3;
+
+/// Inset marker colour.
+const MARKER: [u8; 3] = [255, 220, 0];
+
+fn err(e: impl std::fmt::Display) -> BenchError {
+    BenchError::new(e.to_string())
+}
+
+/// Writes `<scene>-error-vs-time.png`, `<scene>-edge-error-vs-time.png` and, when the sheet's
+/// images are all there, `<scene>-figure1.png`.
+pub fn write_scene_figures(
+    config: &BenchConfig,
+    scene: BenchScene,
+    report: &BenchReport,
+    reference: &Reference,
+    sheet_images: &[(MethodSetting, RgbImage)],
+    exposure: f32,
+    out: &Path,
+) -> Result<(), BenchError> {
+    for (edge, file, what) in [
+        (false, "error-vs-time", "translucent pixels"),
+        (true, "edge-error-vs-time", "shadow-edge band"),
+    ] {
+        let series = config
+            .settings()
+            .into_iter()
+            .map(|setting| Series {
+                label: setting.label(),
+                points: report
+                    .runs
+                    .iter()
+                    .filter(|r| r.scene == scene && r.setting == setting)
+                    .filter_map(|r| {
+                        let e = if edge {
+                            r.edge_error?.mean_relative_l1
+                        } else {
+                            r.error.mean_relative_l1
+                        };
+                        Some((r.timings.total.as_secs_f64(), e))
+                    })
+                    .collect(),
+            })
+            .collect();
+        let chart = Chart {
+            title: format!("{}: error against time ({what})", scene.name()),
+            x_label: "render time (s)".to_string(),
+            y_label: "mean relative error".to_string(),
+            series,
+            log_x: true,
+            log_y: true,
+        };
+        render_chart(&chart, 800, 560)
+            .map_err(err)?
+            .write_png(&out.join(format!("{}-{file}.png", scene.name())))
+            .map_err(err)?;
+    }
+
+    let pick = |method: SssMethod| {
+        sheet_images
+            .iter()
+            .filter(|(s, _)| s.method == method)
+            .min_by(|a, b| {
+                let d = |s: &MethodSetting| (s.epsilon - config.split_epsilon).abs();
+                d(&a.0).total_cmp(&d(&b.0))
+            })
+            .map(|(_, image)| image)
+    };
+    let (Some(hier), Some(lm), Some(n10)) = (
+        pick(SssMethod::Hierarchical),
+        pick(SssMethod::LocalGlobal),
+        pick(SssMethod::EdgeAware),
+    ) else {
+        return Ok(());
+    };
+    let sheet = figure1(config, reference, [hier, lm, n10], exposure)?;
+    render_sheet(&sheet)
+        .map_err(err)?
+        .write_png(&out.join(format!("{}-figure1.png", scene.name())))
+        .map_err(err)
+}
+
+/// The inset square: centred on the shadow-edge pixel nearest the band's centroid.
+fn inset_rect(reference: &Reference) -> (u32, u32, u32) {
+    let (w, h) = reference.image.size();
+    let side = (w.min(h) / 6).max(4);
+    let mask = if reference.band.contains(&true) {
+        &reference.band
+    } else {
+        &reference.translucent
+    };
+    let (mut sx, mut sy, mut n) = (0.0f64, 0.0f64, 0.0f64);
+    for (i, _) in mask.iter().enumerate().filter(|(_, b)| **b) {
+        sx += (i % w as usize) as f64;
+        sy += (i / w as usize) as f64;
+        n += 1.0;
+    }
+    let (cx, cy) = if n > 0.0 {
+        let (mx, my) = (sx / n, sy / n);
+        let nearest = mask
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| **b)
+            .map(|(i, _)| ((i % w as usize) as f64, (i / w as usize) as f64))
+            .min_by(|a, b| {
+                let d = |p: &(f64, f64)| (p.0 - mx).powi(2) + (p.1 - my).powi(2);
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap_or((mx, my));
+        (nearest.0 as u32, nearest.1 as u32)
+    } else {
+        (w / 2, h / 2)
+    };
+    let x0 = cx.saturating_sub(side / 2).min(w.saturating_sub(side));
+    let y0 = cy.saturating_sub(side / 2).min(h.saturating_sub(side));
+    (x0, y0, side)
+}
+
+/// Draws the outline of the inset square into an RGB buffer.
+fn mark(rgb: &mut [u8], width: u32, (x0, y0, side): (u32, u32, u32)) {
+    let height = rgb.len() as u32 / 3 / width.max(1);
+    let mut put = |x: u32, y: u32| {
+        if x < width && y < height {
+            let i = (y * width + x) as usize * 3;
+            rgb[i..i + 3].copy_from_slice(&MARKER);
+        }
+    };
+    for t in 0..side {
+        put(x0 + t, y0);
+        put(x0 + t, y0 + side - 1);
+        put(x0, y0 + t);
+        put(x0 + side - 1, y0 + t);
+    }
+}
+
+fn tile(rgb: Vec<u8>, width: u32, height: u32) -> Tile {
+    Tile { rgb, width, height }
+}
+
+fn inset(rgb: &[u8], width: u32, height: u32, rect: (u32, u32, u32)) -> Result<Tile, BenchError> {
+    let (bytes, w, h) = crop_magnify(
+        rgb, width, height, rect.0, rect.1, rect.2, rect.2, INSET_ZOOM,
+    )
+    .map_err(err)?;
+    Ok(tile(bytes, w, h))
+}
+
+fn figure1(
+    config: &BenchConfig,
+    reference: &Reference,
+    tests: [&RgbImage; 3],
+    exposure: f32,
+) -> Result<Sheet, BenchError> {
+    let (w, h) = reference.image.size();
+    let rect = inset_rect(reference);
+    // One white level for all three error maps: the largest per-pixel relative error.
+    let mut white = 0.0f32;
+    let mut maps = Vec::new();
+    for image in tests {
+        let options = HeatmapOptions {
+            metric: ErrorMetric::Relative,
+            scale: HeatmapScale::Log { decades: 3.0 },
+            max: None,
+        };
+        let m = error_heatmap(
+            image,
+            &reference.image,
+            Some(&reference.translucent),
+            &options,
+        )
+        .map_err(err)?;
+        white = white.max(m.white);
+        maps.push(m);
+    }
+    if white > 0.0 {
+        maps.clear();
+        for image in tests {
+            let options = HeatmapOptions {
+                metric: ErrorMetric::Relative,
+                scale: HeatmapScale::Log { decades: 3.0 },
+                max: Some(white),
+            };
+            maps.push(
+                error_heatmap(
+                    image,
+                    &reference.image,
+                    Some(&reference.translucent),
+                    &options,
+                )
+                .map_err(err)?,
+            );
+        }
+    }
+
+    let mut images = Vec::new();
+    let mut insets = Vec::new();
+    for image in tests.into_iter().chain([&reference.image]) {
+        let rgb = encode_srgb8(image, exposure);
+        insets.push(Some(inset(&rgb, w, h, rect)?));
+        let mut marked = rgb;
+        mark(&mut marked, w, rect);
+        images.push(Some(tile(marked, w, h)));
+    }
+    let mut error_maps = Vec::new();
+    let mut error_insets = Vec::new();
+    for m in &maps {
+        error_insets.push(Some(inset(&m.rgb, m.width, m.height, rect)?));
+        error_maps.push(Some(tile(m.rgb.clone(), m.width, m.height)));
+    }
+    error_maps.push(None);
+    error_insets.push(None);
+
+    Ok(Sheet {
+        title: format!(
+            "{} samples, {}x{}: relative error, log scale over 3 decades, white = {:.1}%",
+            config.sheet_count,
+            w,
+            h,
+            white * 100.0
+        ),
+        column_labels: vec![
+            format!("no smoothing (JB02, eps {})", config.split_epsilon),
+            "LM07 (local-global)".to_string(),
+            "edge-aware (N10)".to_string(),
+            "ground truth".to_string(),
+        ],
+        rows: vec![
+            SheetRow {
+                label: "image".to_string(),
+                tiles: images,
+            },
+            SheetRow {
+                label: format!("shadow edge x{INSET_ZOOM}"),
+                tiles: insets,
+            },
+            SheetRow {
+                label: "error".to_string(),
+                tiles: error_maps,
+            },
+            SheetRow {
+                label: format!("error x{INSET_ZOOM}"),
+                tiles: error_insets,
+            },
+        ],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_marker_outlines_the_inset_square() {
+        let (w, h) = (10u32, 8u32);
+        let mut rgb = vec![0u8; (w * h * 3) as usize];
+        mark(&mut rgb, w, (2, 1, 4));
+        let at = |x: u32, y: u32| &rgb[((y * w + x) * 3) as usize..][..3];
+        assert_eq!(at(2, 1), MARKER);
+        assert_eq!(at(5, 4), MARKER);
+        assert_eq!(at(3, 2), [0, 0, 0], "inside stays");
+        assert_eq!(at(6, 1), [0, 0, 0], "outside stays");
+    }
+}

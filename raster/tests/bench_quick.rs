@@ -1,0 +1,129 @@
+//! Smoke test of `lucent bench --quick`: the real binary runs the whole experiment at a small
+//! size and writes a complete, consistent report.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use lucent_raster::bench::BenchScene;
+use lucent_raster::output::read_png;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lucent-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn column<'a>(header: &'a [&'a str], name: &str) -> usize {
+    header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+}
+
+fn check_png(path: &Path) {
+    let image = read_png(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        image.width() >= 64 && image.height() >= 64,
+        "{}",
+        path.display()
+    );
+    let first = image.pixels()[0];
+    assert!(
+        image.pixels().iter().any(|&p| p != first),
+        "{} is blank",
+        path.display()
+    );
+}
+
+#[test]
+fn quick_bench_writes_a_complete_report() {
+    let out = scratch("bench-quick");
+    let status = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["bench", "--quick", "--quiet", "-o"])
+        .arg(&out)
+        .status()
+        .expect("run lucent");
+    assert!(status.success(), "lucent bench --quick failed: {status}");
+
+    // One CSV row per scene × count × method (quick: 2 counts; hierarchical, LM07, N10).
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3 * 2 * 3, "{csv}");
+    let value = |row: &[&str], name: &str| -> f64 {
+        row[column(&header, name)]
+            .parse()
+            .unwrap_or_else(|e| panic!("{name} = '{}': {e}", row[column(&header, name)]))
+    };
+    for row in &rows {
+        assert_eq!(row.len(), header.len());
+        for name in [
+            "total_s",
+            "shading_s",
+            "cpu_us_per_lookup",
+            "evaluations_per_lookup",
+        ] {
+            assert!(value(row, name) > 0.0, "{name} in {row:?}");
+        }
+        for name in ["error_mean_rel", "error_rmse", "noise_mean_rel"] {
+            let v = value(row, name);
+            assert!(v.is_finite() && v >= 0.0, "{name} = {v} in {row:?}");
+        }
+        // Errors against a 4× denser truth stay small at these counts.
+        assert!(value(row, "error_mean_rel") < 0.5, "{row:?}");
+    }
+    // More samples, less error: hierarchical on the sphere at 8000 beats 2000.
+    let error_at = |scene: &str, method: &str, n: &str| {
+        rows.iter()
+            .find(|r| r[0] == scene && r[1] == method && r[3] == n)
+            .map(|r| value(r, "error_mean_rel"))
+            .unwrap_or_else(|| panic!("no row {scene} {method} {n}"))
+    };
+    for method in ["hierarchical", "edge-aware"] {
+        assert!(
+            error_at("sphere", method, "8000") < error_at("sphere", method, "2000"),
+            "{method}: error does not fall with samples"
+        );
+    }
+
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for needle in [
+        "## Ground truth",
+        "### 1. Edge-aware overhead",
+        "### 2. Shadow edges",
+        "### 3. Texture-mapped",
+        "### 4. Speed",
+    ] {
+        assert!(report.contains(needle), "report.md lacks '{needle}'");
+    }
+    for scene in BenchScene::ALL {
+        for file in ["error-vs-time", "edge-error-vs-time", "figure1"] {
+            check_png(&out.join(format!("{}-{file}.png", scene.name())));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn bench_rejects_bad_options_with_a_message() {
+    let out = scratch("bench-bad");
+    for args in [
+        &["bench", "--quick", "--scenes", "teapot"][..],
+        &["bench", "--quick", "--counts", "5"][..],
+        &["bench", "--quick", "--seeds", "0"][..],
+        &["bench", "--quick", "--resolution", "3"][..],
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_lucent"))
+            .args(args)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .expect("run lucent");
+        assert_eq!(o.status.code(), Some(1), "{args:?}");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(stderr.starts_with("error: "), "{args:?}: {stderr}");
+    }
+    assert!(!out.join("report.md").exists());
+    let _ = std::fs::remove_dir_all(&out);
+}
