@@ -331,16 +331,17 @@ fn render_in_pool(
     };
     let (w, h) = (camera.width as usize, camera.height as usize);
     let b = bar(options.progress, h as u64, "shading");
-    let rows: Vec<Result<Row, RenderError>> = (0..h)
-        .into_par_iter()
-        .map(|y| {
+    // Shaded in place, one row per task: a single buffer, touched once (fresh pages cost a
+    // fault each; rows gathered into a second buffer doubled that).
+    let mut pixels = vec![PixelValue::default(); w * h];
+    let rows: Vec<Result<Row, RenderError>> = pixels
+        .par_chunks_mut(w.max(1))
+        .enumerate()
+        .map(|(y, out)| {
             let mut fragments = Vec::new();
-            let mut row = Row {
-                pixels: Vec::with_capacity(w),
-                ..Row::default()
-            };
-            for x in 0..w {
-                let value = if options.collect_stats {
+            let mut row = Row::default();
+            for (x, slot) in out.iter_mut().enumerate() {
+                *slot = if options.collect_stats {
                     shading.pixel(x as u32, y as u32, &mut fragments, &mut row.stats)?
                 } else {
                     shading.pixel(x as u32, y as u32, &mut fragments, &mut NoStats)?
@@ -350,19 +351,16 @@ fn render_in_pool(
                     .iter()
                     .filter(|f| shading.caches[f.key as usize].is_some())
                     .count() as u64;
-                row.pixels.push(value);
             }
             b.inc(1);
             Ok(row)
         })
         .collect();
     b.finish_and_clear();
-    let mut pixels = Vec::with_capacity(w * h);
     let mut traversal = QueryStats::default();
     let (mut shading_points, mut queries) = (0, 0);
     for row in rows {
         let row = row?;
-        pixels.extend(row.pixels);
         traversal.nodes_opened += row.stats.nodes_opened;
         traversal.aggregates += row.stats.aggregates;
         traversal.samples += row.stats.samples;
@@ -416,10 +414,9 @@ pub fn rasterize(prep: &Prepared) -> Result<(VisibilityBuffer, glam::Mat4), Rend
     Ok((visibility, view_proj))
 }
 
-/// One shaded row and what it cost.
+/// What shading one row cost.
 #[derive(Default)]
 struct Row {
-    pixels: Vec<PixelValue>,
     stats: QueryStats,
     points: u64,
     queries: u64,
