@@ -26,6 +26,7 @@
 //! every error the report lists. The octree's own error at small ε is measured on the
 //! sphere: hierarchical at ε = 0.05 is within 2e-5 of the exhaustive sum on the same
 //! samples.
+
 mod figures;
 mod report;
 mod runner;
