@@ -13,7 +13,7 @@
 //! | shading through the core | [`material`], [`render`] |
 //! | PNG / EXR / PLY output, image comparison | [`output`] |
 //! | 2-D report drawing: charts, contact sheets | [`plot`] |
-//! | run time against error: `lucent bench` | [`bench`] |
+//! | run time against error: `lucent bench` | [`bench`](mod@bench) |
 //! | the `lucent` command | [`cli`] |
 
 pub mod bench;

@@ -69,10 +69,10 @@ pub enum MethodArg {
 pub struct RenderArgs {
     /// Scene file (TOML, see docs/scene-format.md). Without it, the built-in default scene.
     pub scene: Option<PathBuf>,
-    /// Write the PNG here (8-bit sRGB; overrides the scene's [output] png).
+    /// Write the PNG here (8-bit sRGB; overrides the scene's `[output]` png).
     #[arg(short, long, value_name = "OUT.png")]
     pub output: Option<PathBuf>,
-    /// Write the OpenEXR here (linear float; overrides the scene's [output] exr).
+    /// Write the OpenEXR here (linear float; overrides the scene's `[output]` exr).
     #[arg(long, value_name = "OUT.exr")]
     pub exr: Option<PathBuf>,
     /// Subsurface method.

@@ -8,7 +8,7 @@
 //!
 //! - **RMS noise** = √(Σ s² / (3 · pixels)): in the image's units.
 //! - **Mean relative noise** = Σ s / (|mean| + [`RELATIVE_L1_OFFSET`]) / (3 · pixels): the
-//!   same normalisation as the mean relative L1 error of [`compare`](super::compare), so the
+//!   same normalisation as the mean relative L1 error of [`compare()`](super::compare()), so the
 //!   two can be read side by side.
 //!
 //! Sums are in `f64` in scan order (deterministic).

@@ -27,7 +27,7 @@ pub struct ObjectSamples {
     pub normals: Vec<Vec3>,
     /// Areas (scene units²).
     pub areas: Vec<f32>,
-    /// Irradiance (filled by [`light_samples`]).
+    /// Irradiance (filled when the samples are lit).
     pub irradiance: Vec<Vec3>,
 }
 
