@@ -76,9 +76,11 @@ pub trait Lanes:
     fn sqrt(self) -> Self;
     /// Lane-wise e^x for x ≤ 0 (lanes below −87.3 give 0).
     fn exp_nonpositive(self) -> Self;
-    /// Lane-wise minimum.
+    /// Lane-wise minimum, `if self < o { self } else { o }`: `o` where either is NaN (the
+    /// plain `minps`; every caller clamps against a bound that is never NaN, and the NaN-aware
+    /// version cost a compare and a blend more per register).
     fn min(self, o: Self) -> Self;
-    /// Lane-wise maximum.
+    /// Lane-wise maximum, `if self > o { self } else { o }`: `o` where either is NaN (`maxps`).
     fn max(self, o: Self) -> Self;
     /// Lanes where `self < o`.
     fn lt(self, o: Self) -> Mask;
@@ -158,7 +160,7 @@ impl Lanes for ScalarLanes {
     fn min(self, o: Self) -> Self {
         let mut r = self.0;
         for i in 0..LANES {
-            r[i] = r[i].min(o.0[i]);
+            r[i] = if r[i] < o.0[i] { r[i] } else { o.0[i] };
         }
         ScalarLanes(r)
     }
@@ -166,7 +168,7 @@ impl Lanes for ScalarLanes {
     fn max(self, o: Self) -> Self {
         let mut r = self.0;
         for i in 0..LANES {
-            r[i] = r[i].max(o.0[i]);
+            r[i] = if r[i] > o.0[i] { r[i] } else { o.0[i] };
         }
         ScalarLanes(r)
     }
@@ -266,11 +268,11 @@ mod simd {
         }
         #[inline(always)]
         fn min(self, o: Self) -> Self {
-            SimdLanes(self.0.min(o.0))
+            SimdLanes(self.0.fast_min(o.0))
         }
         #[inline(always)]
         fn max(self, o: Self) -> Self {
-            SimdLanes(self.0.max(o.0))
+            SimdLanes(self.0.fast_max(o.0))
         }
         #[inline(always)]
         fn lt(self, o: Self) -> Mask {
@@ -303,6 +305,10 @@ mod tests {
             assert_eq!((la / lb).to_array()[i], a[i] / b[i]);
             assert_eq!(la.min(lb).to_array()[i], a[i].min(b[i]));
             assert_eq!(la.max(lb).to_array()[i], a[i].max(b[i]));
+            // NaN in either operand gives the second one.
+            let nan = L::splat(f32::NAN);
+            assert!(nan.min(lb).to_array()[i] == b[i] && nan.max(lb).to_array()[i] == b[i]);
+            assert!(la.min(nan).to_array()[i].is_nan() && la.max(nan).to_array()[i].is_nan());
             assert_eq!(la.lt(lb).0 >> i & 1 == 1, a[i] < b[i]);
             let kept = la.keep(Mask(0b1010_0101)).to_array()[i];
             assert_eq!(kept, if 0b1010_0101 >> i & 1 == 1 { a[i] } else { 0.0 });
