@@ -88,6 +88,25 @@ pub(crate) struct Sums {
     pub local_weight: Vec3,
 }
 
+/// For each 8-bit lane mask, its set lanes in increasing order (then zeros).
+const fn compact_table() -> [[u8; LANES]; 256] {
+    let mut t = [[0u8; LANES]; 256];
+    let mut m = 0;
+    while m < 256 {
+        let (mut lane, mut n) = (0, 0);
+        while lane < LANES {
+            if m & (1 << lane) != 0 {
+                t[m][n] = lane as u8;
+                n += 1;
+            }
+            lane += 1;
+        }
+        m += 1;
+    }
+    t
+}
+static COMPACT: [[u8; LANES]; 256] = compact_table();
+
 /// Pending terms, `C` columns in structure-of-arrays form.
 struct Buffer<const C: usize> {
     columns: [[f32; BUFFER]; C],
@@ -103,18 +122,23 @@ impl<const C: usize> Buffer<C> {
     }
 
     /// Appends the lanes of `keep`; true when a full batch is ready.
+    ///
+    /// Branch-free: every column gets eight entries at `len`, the kept lanes first in order
+    /// (from [`COMPACT`]), and `len` grows by the number kept; the entries past it are
+    /// overwritten by the next append or masked when evaluated. The first version looped over
+    /// the set bits of `keep` and stored lane by lane, reloading `len` after every store.
     #[inline(always)]
     fn append<L: Lanes>(&mut self, keep: Mask, values: [L; C]) -> bool {
-        let values = values.map(|v| v.to_array());
-        let mut bits = keep.0;
-        while bits != 0 {
-            let lane = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            for (column, v) in self.columns.iter_mut().zip(&values) {
-                column[self.len] = v[lane];
+        let order = &COMPACT[(keep.0 & 0xff) as usize];
+        let len = self.len.min(LANES);
+        for (column, v) in self.columns.iter_mut().zip(values) {
+            let v = v.to_array();
+            let dst = &mut column[len..len + LANES];
+            for i in 0..LANES {
+                dst[i] = v[(order[i] & 7) as usize];
             }
-            self.len += 1;
         }
+        self.len = len + keep.0.count_ones() as usize;
         self.len >= LANES
     }
 
