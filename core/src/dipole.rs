@@ -280,19 +280,22 @@ impl Dipole {
         let r2 = r2.min(L::splat(MAX_R2));
         let sigma = L::splat(self.sigma_tr);
         let one = L::splat(1.0);
+        // The halves of q and tr C, shared by both sources (and, once inlined, all channels).
+        let half = L::splat(0.5);
+        let (half_q, half_trace) = (half * q, half * trace);
         let source = |z: f32, z2: f32| {
             let d2 = r2 + L::splat(z2);
             let d = d2.sqrt();
             let u = sigma * d;
             let e = (L::splat(0.0) - u).exp_nonpositive();
             let inv_d2 = one / d2;
-            let e_d3 = e / (d * d2);
-            let value = L::splat(z) * (u + one) * e_d3;
-            let zeta = L::splat(z2) * inv_d2;
+            // w = z e/d³; the value is w (u + 1) and the correction ½ w/d² [q (1 − ζ) p5 −
+            // tr C p2], with 1 − ζ = r²/d² (no cancellation where r ≪ z).
+            let w = L::splat(z) * (e / (d * d2));
+            let value = w * (u + one);
             let p5 = ((u + L::splat(6.0)) * u + L::splat(15.0)) * u + L::splat(15.0);
             let p2 = (u + L::splat(3.0)) * u + L::splat(3.0);
-            let k = L::splat(0.5 * z) * e_d3 * inv_d2;
-            let correction = k * (q * (one - zeta) * p5 - trace * p2);
+            let correction = w * inv_d2 * (half_q * (r2 * inv_d2) * p5 - half_trace * p2);
             (value, correction)
         };
         let (tr, cr) = source(self.z_r, self.z_r2);
