@@ -192,14 +192,21 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         }
     }
 
-    /// Adds the lane sums to the double-precision totals and clears them.
+    /// Adds the lane sums to the double-precision totals and clears them (only N10 has local
+    /// sums: the other modes skip their six reductions of zeros).
     fn fold(&mut self) {
         let zero = L::splat(0.0);
-        for (total, lanes) in self.folded.iter_mut().zip([
-            &mut self.global,
-            &mut self.local_flux,
-            &mut self.local_weight,
-        ]) {
+        let sums = if MODE == EDGE_AWARE { 3 } else { 1 };
+        for (total, lanes) in self
+            .folded
+            .iter_mut()
+            .zip([
+                &mut self.global,
+                &mut self.local_flux,
+                &mut self.local_weight,
+            ])
+            .take(sums)
+        {
             for c in 0..3 {
                 total[c] += lanes[c].reduce_add() as f64;
                 lanes[c] = zero;
