@@ -131,14 +131,25 @@ impl<const C: usize> Buffer<C> {
     fn append<L: Lanes>(&mut self, keep: Mask, values: [L; C]) -> bool {
         let order = &COMPACT[(keep.0 & 0xff) as usize];
         let len = self.len.min(LANES);
-        for (column, v) in self.columns.iter_mut().zip(values) {
-            let v = v.to_array();
-            let dst = &mut column[len..len + LANES];
-            for i in 0..LANES {
-                dst[i] = v[(order[i] & 7) as usize];
+        let n = keep.0.count_ones() as usize;
+        if n <= LANES / 2 {
+            for (column, v) in self.columns.iter_mut().zip(values) {
+                let v = v.to_array();
+                let dst = &mut column[len..len + LANES / 2];
+                for i in 0..LANES / 2 {
+                    dst[i] = v[(order[i] & 7) as usize];
+                }
+            }
+        } else {
+            for (column, v) in self.columns.iter_mut().zip(values) {
+                let v = v.to_array();
+                let dst = &mut column[len..len + LANES];
+                for i in 0..LANES {
+                    dst[i] = v[(order[i] & 7) as usize];
+                }
             }
         }
-        self.len = len + keep.0.count_ones() as usize;
+        self.len = len + n;
         self.len >= LANES
     }
 
