@@ -141,7 +141,9 @@ mod wide_exp {
         // x − x is 0, or NaN in NaN lanes (and in −∞ lanes, which underflow): adding it keeps
         // NaN lanes NaN for two instructions where a compare and a select took four. Then
         // flush underflow to zero.
-        underflow.select(zero, e * scale + (x - x))
+        #[allow(clippy::eq_op)] // x − x is the point: 0, or NaN
+        let nan_or_zero = x - x;
+        underflow.select(zero, e * scale + nan_or_zero)
     }
 }
 
