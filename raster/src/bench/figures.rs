@@ -24,10 +24,6 @@ const INSET_ZOOM: u32 = 3;
 /// Inset marker colour.
 const MARKER: [u8; 3] = [255, 220, 0];
 
-fn err(e: impl std::fmt::Display) -> BenchError {
-    BenchError::new(e.to_string())
-}
-
 /// Writes `<scene>-error-vs-time.png`, `<scene>-edge-error-vs-time.png` and, when the sheet's
 /// images are all there, `<scene>-figure1.png`.
 pub fn write_scene_figures(
@@ -71,10 +67,8 @@ pub fn write_scene_figures(
             log_x: true,
             log_y: true,
         };
-        render_chart(&chart, 800, 560)
-            .map_err(err)?
-            .write_png(&out.join(format!("{}-{file}.png", scene.name())))
-            .map_err(err)?;
+        render_chart(&chart, 800, 560)?
+            .write_png(&out.join(format!("{}-{file}.png", scene.name())))?;
     }
 
     let pick = |method: SssMethod| {
@@ -95,10 +89,8 @@ pub fn write_scene_figures(
         return Ok(());
     };
     let sheet = figure1(config, reference, [hier, lm, n10], exposure)?;
-    render_sheet(&sheet)
-        .map_err(err)?
-        .write_png(&out.join(format!("{}-figure1.png", scene.name())))
-        .map_err(err)
+    render_sheet(&sheet)?.write_png(&out.join(format!("{}-figure1.png", scene.name())))?;
+    Ok(())
 }
 
 /// The inset square: centred on the shadow-edge pixel nearest the band's centroid.
@@ -161,8 +153,7 @@ fn tile(rgb: Vec<u8>, width: u32, height: u32) -> Tile {
 fn inset(rgb: &[u8], width: u32, height: u32, rect: (u32, u32, u32)) -> Result<Tile, BenchError> {
     let (bytes, w, h) = crop_magnify(
         rgb, width, height, rect.0, rect.1, rect.2, rect.2, INSET_ZOOM,
-    )
-    .map_err(err)?;
+    )?;
     Ok(tile(bytes, w, h))
 }
 
@@ -188,8 +179,7 @@ fn figure1(
             &reference.image,
             Some(&reference.translucent),
             &options,
-        )
-        .map_err(err)?;
+        )?;
         white = white.max(m.white);
         maps.push(m);
     }
@@ -201,15 +191,12 @@ fn figure1(
                 scale: HeatmapScale::Log { decades: 3.0 },
                 max: Some(white),
             };
-            maps.push(
-                error_heatmap(
-                    image,
-                    &reference.image,
-                    Some(&reference.translucent),
-                    &options,
-                )
-                .map_err(err)?,
-            );
+            maps.push(error_heatmap(
+                image,
+                &reference.image,
+                Some(&reference.translucent),
+                &options,
+            )?);
         }
     }
 

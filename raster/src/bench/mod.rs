@@ -40,9 +40,10 @@ pub use report::{write_csv, write_markdown};
 pub use runner::{MethodSetting, Reference, RunResult};
 pub use scenes::BenchScene;
 
-use crate::output::{ErrorStats, compare, write_exr, write_png};
-use crate::render::{RenderOptions, render};
-use crate::scene::{SssMethod, default_scene};
+use crate::output::{ErrorStats, OutputError, compare, write_exr, write_png};
+use crate::plot::PlotError;
+use crate::render::{RenderError, RenderOptions, render};
+use crate::scene::{SceneError, SssMethod, default_scene};
 
 /// Why the benchmark stopped.
 #[derive(Debug)]
@@ -62,6 +63,19 @@ impl fmt::Display for BenchError {
 }
 
 impl std::error::Error for BenchError {}
+
+/// Every step's error becomes a [`BenchError`] with its message (which names the file or the
+/// problem already).
+macro_rules! bench_error_from {
+    ($($source:ty),*) => {$(
+        impl From<$source> for BenchError {
+            fn from(e: $source) -> Self {
+                BenchError(e.to_string())
+            }
+        }
+    )*};
+}
+bench_error_from!(OutputError, RenderError, SceneError, PlotError);
 
 /// What the benchmark runs.
 #[derive(Clone, Debug, PartialEq)]
@@ -311,9 +325,7 @@ fn run_scene(
     log: &mut dyn FnMut(&str),
 ) -> Result<(), BenchError> {
     let name = scene.name();
-    let mut base = scene
-        .load(config.resolution)
-        .map_err(|e| BenchError::new(e.to_string()))?;
+    let mut base = scene.load(config.resolution)?;
     base.render.threads = config.threads;
     let mut truth_scene = base.clone();
     truth_scene.render.cull_tolerance = truth_scene.render.cull_tolerance.min(1e-6);
@@ -333,8 +345,7 @@ fn run_scene(
         &runner::configure(&truth_scene, truth_setting, n / 2, 1001),
         false,
     )?;
-    let convergence = compare(&half.image, &reference.image, Some(&reference.translucent))
-        .map_err(|e| BenchError::new(e.to_string()))?;
+    let convergence = compare(&half.image, &reference.image, Some(&reference.translucent))?;
     report.truths.push(TruthInfo {
         scene,
         samples: reference.samples,
@@ -412,11 +423,9 @@ fn table_check(
         exact_local_integral: true,
         ..RenderOptions::default()
     };
-    let exact = render(&scene, &options).map_err(|e| BenchError::new(e.to_string()))?;
-    let error = compare(&table.image, &exact.image, Some(&reference.translucent))
-        .map_err(|e| BenchError::new(e.to_string()))?;
-    let exact_error = compare(&exact.image, &reference.image, Some(&reference.translucent))
-        .map_err(|e| BenchError::new(e.to_string()))?;
+    let exact = render(&scene, &options)?;
+    let error = compare(&table.image, &exact.image, Some(&reference.translucent))?;
+    let exact_error = compare(&exact.image, &reference.image, Some(&reference.translucent))?;
     // The table's shading time: the median of the seeds from the main runs when there is one.
     let table_shading = report
         .runs
@@ -491,15 +500,13 @@ fn end_to_end(out: &Path, threads: Option<usize>) -> Result<Duration, BenchError
     let mut scene = default_scene();
     scene.render.threads = threads;
     let options = RenderOptions::default();
-    let r = render(&scene, &options).map_err(|e| BenchError::new(e.to_string()))?;
-    write_png(&dir.join("lucent.png"), &r.image, scene.render.exposure)
-        .map_err(|e| BenchError::new(e.to_string()))?;
+    let r = render(&scene, &options)?;
+    write_png(&dir.join("lucent.png"), &r.image, scene.render.exposure)?;
     write_exr(
         &dir.join("lucent.exr"),
         &r.image,
         &r.layers(&scene.output.layers),
-    )
-    .map_err(|e| BenchError::new(e.to_string()))?;
+    )?;
     Ok(start.elapsed())
 }
 

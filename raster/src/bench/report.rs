@@ -20,8 +20,8 @@ fn write_file(path: &Path, text: &str) -> Result<(), BenchError> {
     write_atomically(path, |f| {
         f.write_all(text.as_bytes())
             .map_err(|e| OutputError::io(path, "writing", e))
-    })
-    .map_err(|e| BenchError::new(e.to_string()))
+    })?;
+    Ok(())
 }
 
 fn pct(x: f64) -> String {

@@ -73,8 +73,7 @@ impl Reference {
             width,
             height,
             default_band_radius(width, height),
-        )
-        .map_err(|e| BenchError::new(e.to_string()))?;
+        )?;
         Ok(Reference {
             image: r.image,
             translucent,
@@ -86,13 +85,9 @@ impl Reference {
 
     /// Errors of `image` over the translucent pixels and (if any) the edge band.
     pub fn errors(&self, image: &RgbImage) -> Result<(ErrorStats, Option<ErrorStats>), BenchError> {
-        let all = compare(image, &self.image, Some(&self.translucent))
-            .map_err(|e| BenchError::new(e.to_string()))?;
+        let all = compare(image, &self.image, Some(&self.translucent))?;
         let edge = if self.band.contains(&true) {
-            Some(
-                compare(image, &self.image, Some(&self.band))
-                    .map_err(|e| BenchError::new(e.to_string()))?,
-            )
+            Some(compare(image, &self.image, Some(&self.band))?)
         } else {
             None
         };
@@ -224,10 +219,7 @@ pub fn run_config(
     let (error, edge_error) = reference.errors(&first.image)?;
     let noise = if renders.len() >= 2 {
         let images: Vec<&RgbImage> = renders.iter().map(|r| &r.image).collect();
-        Some(
-            seed_noise(&images, Some(&reference.translucent))
-                .map_err(|e| BenchError::new(e.to_string()))?,
-        )
+        Some(seed_noise(&images, Some(&reference.translucent))?)
     } else {
         None
     };
