@@ -40,7 +40,7 @@ pub use report::{write_csv, write_markdown};
 pub use runner::{MethodSetting, Reference, RunResult};
 pub use scenes::BenchScene;
 
-use crate::output::{ErrorStats, OutputError, compare, write_exr, write_png};
+use crate::output::{ErrorStats, OutputError, RgbImage, compare, write_exr, write_png};
 use crate::plot::PlotError;
 use crate::render::{RenderError, RenderOptions, render};
 use crate::scene::{SceneError, SssMethod, default_scene};
@@ -178,6 +178,9 @@ impl BenchConfig {
         }
         if self.counts.is_empty() || self.counts.iter().any(|&c| !(100..=4_000_000).contains(&c)) {
             return bad("sample counts must be in 100..=4000000");
+        }
+        if !self.counts.contains(&self.sheet_count) {
+            return bad("the sheet count must be one of the sample counts");
         }
         if self.seeds.is_empty() {
             return bad("at least one seed is needed");
@@ -390,7 +393,14 @@ fn run_scene(
 
     match scene {
         BenchScene::Textured => {
-            report.table = Some(table_check(config, &base, report, &reference, log)?);
+            report.table = Some(table_check(
+                config,
+                &base,
+                report,
+                &sheet_images,
+                &reference,
+                log,
+            )?);
         }
         BenchScene::Sphere => {
             report.exhaustive = exhaustive_check(config, &base, log)?;
@@ -400,11 +410,14 @@ fn run_scene(
     Ok(())
 }
 
-/// Edge-aware with K from the table against K by quadrature at every shading point.
+/// Edge-aware with K from the table against K by quadrature at every shading point. The table
+/// side is the main run at the sheet count (its first seed's image, its median shading time):
+/// only the quadrature render is new.
 fn table_check(
     config: &BenchConfig,
     base: &crate::scene::Scene,
     report: &BenchReport,
+    sheet_images: &[(MethodSetting, RgbImage)],
     reference: &Reference,
     log: &mut dyn FnMut(&str),
 ) -> Result<TableCheck, BenchError> {
@@ -412,35 +425,31 @@ fn table_check(
         method: SssMethod::EdgeAware,
         epsilon: config.split_epsilon,
     };
-    let scene = runner::configure(base, setting, config.sheet_count, config.seeds[0]);
+    let run = report::find(report, BenchScene::Textured, setting, config.sheet_count);
+    let image = sheet_images.iter().find(|(s, _)| *s == setting);
+    let (Some(run), Some((_, table_image))) = (run, image) else {
+        return Err(BenchError::new(
+            "internal: the edge-aware run at the sheet count is missing",
+        ));
+    };
     log(&format!(
         "textured: K table vs K by quadrature, {} samples",
         config.sheet_count
     ));
-    let table = runner::render_once(&scene, false)?;
+    let scene = runner::configure(base, setting, config.sheet_count, config.seeds[0]);
     let options = RenderOptions {
         collect_stats: true,
         exact_local_integral: true,
         ..RenderOptions::default()
     };
     let exact = render(&scene, &options)?;
-    let error = compare(&table.image, &exact.image, Some(&reference.translucent))?;
+    let error = compare(table_image, &exact.image, Some(&reference.translucent))?;
     let exact_error = compare(&exact.image, &reference.image, Some(&reference.translucent))?;
-    // The table's shading time: the median of the seeds from the main runs when there is one.
-    let table_shading = report
-        .runs
-        .iter()
-        .find(|r| {
-            r.scene == BenchScene::Textured
-                && r.setting == setting
-                && r.samples == config.sheet_count
-        })
-        .map_or(table.stats.timings.shading, |r| r.timings.shading);
     Ok(TableCheck {
-        samples: table.stats.samples,
+        samples: run.placed,
         error,
         exact_error,
-        table_shading,
+        table_shading: run.timings.shading,
         exact_shading: exact.stats.timings.shading,
     })
 }
@@ -539,6 +548,7 @@ mod tests {
         check(|c| c.resolution = 8, "resolution");
         check(|c| c.counts = vec![10], "sample counts");
         check(|c| c.counts.clear(), "sample counts");
+        check(|c| c.sheet_count = 3_000, "sheet count");
         check(|c| c.seeds.clear(), "seed");
         check(|c| c.epsilons = vec![f32::NAN], "ε");
         check(|c| c.truth_epsilon = 0.0, "ε");
