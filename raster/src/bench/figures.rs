@@ -13,6 +13,7 @@ use std::path::Path;
 
 use super::runner::{MethodSetting, Reference};
 use super::{BenchConfig, BenchError, BenchReport, BenchScene};
+use crate::output::heatmap::max_pixel_error;
 use crate::output::png::encode_srgb8;
 use crate::output::{ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, error_heatmap};
 use crate::plot::{Chart, Series, Sheet, SheetRow, Tile, crop_magnify, render_chart, render_sheet};
@@ -166,39 +167,25 @@ fn figure1(
     let (w, h) = reference.image.size();
     let rect = inset_rect(reference);
     // One white level for all three error maps: the largest per-pixel relative error.
+    let mask = Some(reference.translucent.as_slice());
     let mut white = 0.0f32;
-    let mut maps = Vec::new();
     for image in tests {
-        let options = HeatmapOptions {
-            metric: ErrorMetric::Relative,
-            scale: HeatmapScale::Log { decades: 3.0 },
-            max: None,
-        };
-        let m = error_heatmap(
+        white = white.max(max_pixel_error(
             image,
             &reference.image,
-            Some(&reference.translucent),
-            &options,
-        )?;
-        white = white.max(m.white);
-        maps.push(m);
+            mask,
+            ErrorMetric::Relative,
+        )?);
     }
-    if white > 0.0 {
-        maps.clear();
-        for image in tests {
-            let options = HeatmapOptions {
-                metric: ErrorMetric::Relative,
-                scale: HeatmapScale::Log { decades: 3.0 },
-                max: Some(white),
-            };
-            maps.push(error_heatmap(
-                image,
-                &reference.image,
-                Some(&reference.translucent),
-                &options,
-            )?);
-        }
-    }
+    let options = HeatmapOptions {
+        metric: ErrorMetric::Relative,
+        scale: HeatmapScale::Log { decades: 3.0 },
+        max: (white > 0.0).then_some(white),
+    };
+    let maps = tests
+        .iter()
+        .map(|image| error_heatmap(image, &reference.image, mask, &options))
+        .collect::<Result<Vec<_>, _>>()?;
 
     let mut images = Vec::new();
     let mut insets = Vec::new();

@@ -124,6 +124,38 @@ fn pixel_error(metric: ErrorMetric, a: glam::Vec3, b: glam::Vec3) -> f32 {
     (sum / 3.0) as f32
 }
 
+fn pixel_errors(test: &RgbImage, reference: &RgbImage, metric: ErrorMetric) -> Vec<f32> {
+    test.pixels()
+        .iter()
+        .zip(reference.pixels())
+        .map(|(&a, &b)| pixel_error(metric, a, b))
+        .collect()
+}
+
+fn largest_included(errors: &[f32], mask: Option<&[bool]>) -> f32 {
+    errors
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| mask.is_none_or(|m| m[i]))
+        .fold(0.0f32, |m, (_, &e)| m.max(e))
+}
+
+/// The largest per-pixel error over the included pixels: the white level a heat map gets
+/// without [`HeatmapOptions::max`]. The largest over several images gives their heat maps one
+/// scale.
+pub fn max_pixel_error(
+    test: &RgbImage,
+    reference: &RgbImage,
+    mask: Option<&[bool]>,
+    metric: ErrorMetric,
+) -> Result<f32, OutputError> {
+    check_inputs(test, reference, mask)?;
+    Ok(largest_included(
+        &pixel_errors(test, reference, metric),
+        mask,
+    ))
+}
+
 /// Builds the heat map of `test` against `reference` (see the module doc).
 pub fn error_heatmap(
     test: &RgbImage,
@@ -150,19 +182,10 @@ pub fn error_heatmap(
     }
 
     let included = |i: usize| mask.is_none_or(|m| m[i]);
-    let errors: Vec<f32> = test
-        .pixels()
-        .iter()
-        .zip(reference.pixels())
-        .map(|(&a, &b)| pixel_error(options.metric, a, b))
-        .collect();
-    let white = options.max.unwrap_or_else(|| {
-        errors
-            .iter()
-            .enumerate()
-            .filter(|&(i, _)| included(i))
-            .fold(0.0f32, |m, (_, &e)| m.max(e))
-    });
+    let errors = pixel_errors(test, reference, options.metric);
+    let white = options
+        .max
+        .unwrap_or_else(|| largest_included(&errors, mask));
     let black = match options.scale {
         HeatmapScale::Linear => 0.0,
         HeatmapScale::Log { decades } => white * 10f32.powf(-decades),
@@ -278,6 +301,35 @@ mod tests {
         let h = error_heatmap(&test, &reference, None, &opts).unwrap();
         assert_eq!(&h.rgb[3..6], &[30, 0, 55]);
         assert_eq!(&h.rgb[9..12], &[205, 30, 110]);
+    }
+
+    #[test]
+    fn max_pixel_error_is_the_default_white() {
+        // Absolute per-pixel errors 0, 0.5, 1.0, 2.0; the mask drops the last.
+        let reference = img(4, 1, &[[0.0; 3]; 4]);
+        let test = img(
+            4,
+            1,
+            &[[0.0; 3], [1.5, 0.0, 0.0], [1.0; 3], [6.0, 0.0, 0.0]],
+        );
+        let mask = [true, true, true, false];
+        for m in [None, Some(&mask[..])] {
+            let white = error_heatmap(&test, &reference, m, &HeatmapOptions::default())
+                .unwrap()
+                .white;
+            let max = max_pixel_error(&test, &reference, m, ErrorMetric::Absolute).unwrap();
+            assert_eq!(max, white);
+            assert_eq!(max, if m.is_some() { 1.0 } else { 2.0 });
+        }
+        assert!(
+            max_pixel_error(
+                &test,
+                &img(3, 1, &[[0.0; 3]; 3]),
+                None,
+                ErrorMetric::Absolute
+            )
+            .is_err()
+        );
     }
 
     #[test]
