@@ -62,10 +62,16 @@ fn quick_bench_writes_a_complete_report() {
             "total_s",
             "shading_s",
             "cpu_us_per_lookup",
+            "shading_us_per_lookup",
             "evaluations_per_lookup",
         ] {
             assert!(value(row, name) > 0.0, "{name} in {row:?}");
         }
+        // A lookup's CPU is part of the shading phase, which also shades the opaque pixels.
+        assert!(
+            value(row, "cpu_us_per_lookup") < value(row, "shading_us_per_lookup"),
+            "{row:?}"
+        );
         for name in ["error_mean_rel", "error_rmse", "noise_mean_rel"] {
             let v = value(row, name);
             assert!(v.is_finite() && v >= 0.0, "{name} = {v} in {row:?}");

@@ -228,3 +228,27 @@ fn renders_are_identical_across_runs_and_thread_counts() {
     scene.render.method = SssMethod::Hierarchical;
     assert_ne!(one, bits(&scene));
 }
+
+#[test]
+fn statistics_time_the_translucent_points_without_changing_the_image() {
+    let scene = plane_scene("edge-aware", true, 32, 2_000);
+    let plain = render(&scene, &RenderOptions::default()).unwrap();
+    assert_eq!(plain.stats.translucent_time, None);
+    assert_eq!(plain.stats.traversal, None);
+    let counted = render(
+        &scene,
+        &RenderOptions {
+            collect_stats: true,
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(plain.image.pixels(), counted.image.pixels());
+    let time = counted.stats.translucent_time.expect("timed");
+    let traversal = counted.stats.traversal.expect("counted");
+    assert!(counted.stats.queries > 0 && traversal.queries == counted.stats.queries);
+    assert!(time > std::time::Duration::ZERO, "{time:?}");
+    // Summed over threads, the points cannot take longer than the phase on all threads.
+    let bound = counted.stats.timings.shading * counted.stats.threads as u32;
+    assert!(time <= bound, "{time:?} > {bound:?}");
+}

@@ -236,8 +236,10 @@ pub struct ExhaustiveRow {
     pub samples: usize,
     /// Against the exhaustive sum on the same samples, translucent pixels.
     pub error: ErrorStats,
-    /// Shading wall × threads per lookup, µs.
+    /// CPU per translucent shading point, µs (see [`RunResult::cpu_us_per_lookup`]).
     pub cpu_us_per_lookup: f64,
+    /// The whole shading phase (opaque pixels too) per lookup, µs.
+    pub shading_us_per_lookup: f64,
     /// Profile evaluations per lookup.
     pub evaluations_per_lookup: f64,
 }
@@ -494,6 +496,7 @@ fn exhaustive_check(
             samples: r.placed,
             error: r.error,
             cpu_us_per_lookup: r.cpu_us_per_lookup(),
+            shading_us_per_lookup: r.shading_us_per_lookup(),
             evaluations_per_lookup: r.evaluations_per_lookup(),
         });
     }

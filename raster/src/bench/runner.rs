@@ -114,6 +114,8 @@ pub struct RunResult {
     pub threads: usize,
     /// Translucent lookups per render.
     pub queries: u64,
+    /// CPU time of the translucent shading points (median over the seeds).
+    pub translucent_time: Duration,
     /// Traversal counters of the first seed.
     pub traversal: QueryStats,
     /// Cache bytes (first seed).
@@ -127,8 +129,19 @@ pub struct RunResult {
 }
 
 impl RunResult {
-    /// Shading wall time × threads per lookup, in µs.
+    /// CPU per lookup in µs: the time of the translucent shading points (surface attributes,
+    /// material, E(x) where the method needs it, the query, the radiance; see
+    /// [`ShadingStats`](crate::render::ShadingStats)) summed over threads, per lookup. The
+    /// opaque pixels of the image are not charged to it.
     pub fn cpu_us_per_lookup(&self) -> f64 {
+        if self.queries == 0 {
+            return 0.0;
+        }
+        self.translucent_time.as_secs_f64() / self.queries as f64 * 1e6
+    }
+
+    /// The whole shading phase (wall × threads, opaque pixels included) per lookup, in µs.
+    pub fn shading_us_per_lookup(&self) -> f64 {
         if self.queries == 0 {
             return 0.0;
         }
@@ -233,6 +246,12 @@ pub fn run_config(
         timings: median_timings(&timings),
         threads: first.stats.threads,
         queries: first.stats.queries,
+        translucent_time: median(
+            renders
+                .iter()
+                .map(|r| r.stats.translucent_time.unwrap_or_default())
+                .collect(),
+        ),
         traversal: first.stats.traversal.unwrap_or_default(),
         cache_bytes: first.stats.cache_bytes,
         error,
@@ -284,5 +303,12 @@ mod tests {
         assert!(noise.rms > 0.0, "another seed moves the samples: {noise:?}");
         assert!(result.queries > 0 && result.evaluations_per_lookup() > 0.0);
         assert!(result.cpu_us_per_lookup() > 0.0);
+        // The translucent points are part of the shading phase, which also shades the floor.
+        assert!(
+            result.cpu_us_per_lookup() < result.shading_us_per_lookup(),
+            "{} vs {}",
+            result.cpu_us_per_lookup(),
+            result.shading_us_per_lookup()
+        );
     }
 }

@@ -27,7 +27,7 @@ use rayon::prelude::*;
 pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
 pub use irradiance::ObjectSamples;
 pub use prepare::{Prepared, can_occlude};
-pub use shading::{ObjectCache, PixelValue, Shading};
+pub use shading::{ObjectCache, PixelValue, Shading, ShadingCounters, ShadingStats};
 
 use crate::lights::Lighting;
 use crate::material::Shader;
@@ -79,7 +79,7 @@ pub struct RenderOptions<'a> {
     pub baked: Option<&'a [ObjectSamples]>,
     /// Show progress bars on stderr (only when it is a terminal).
     pub progress: bool,
-    /// Count traversal statistics (slightly slower).
+    /// Count traversal statistics and time the translucent shading points (slightly slower).
     pub collect_stats: bool,
     /// Compute K by quadrature at every shading point instead of the power-of-two table.
     pub exact_local_integral: bool,
@@ -121,6 +121,9 @@ pub struct RenderStats {
     pub queries: u64,
     /// Traversal counters, if collected.
     pub traversal: Option<QueryStats>,
+    /// CPU time of the translucent shading points summed over threads, if collected (see
+    /// [`ShadingStats`]).
+    pub translucent_time: Option<Duration>,
     /// Time per phase.
     pub timings: Timings,
     /// Threads used.
@@ -358,13 +361,16 @@ fn render_in_pool(
         .collect();
     b.finish_and_clear();
     let mut traversal = QueryStats::default();
+    let mut translucent_time = Duration::ZERO;
     let (mut shading_points, mut queries) = (0, 0);
     for row in rows {
         let row = row?;
-        traversal.nodes_opened += row.stats.nodes_opened;
-        traversal.aggregates += row.stats.aggregates;
-        traversal.samples += row.stats.samples;
-        traversal.culled += row.stats.culled;
+        let counted = row.stats.traversal;
+        traversal.nodes_opened += counted.nodes_opened;
+        traversal.aggregates += counted.aggregates;
+        traversal.samples += counted.samples;
+        traversal.culled += counted.culled;
+        translucent_time += row.stats.translucent_time;
         shading_points += row.points;
         queries += row.queries;
     }
@@ -387,6 +393,7 @@ fn render_in_pool(
             shading_points,
             queries,
             traversal: options.collect_stats.then_some(traversal),
+            translucent_time: options.collect_stats.then_some(translucent_time),
             timings,
             threads,
         },
@@ -417,7 +424,7 @@ pub fn rasterize(prep: &Prepared) -> Result<(VisibilityBuffer, glam::Mat4), Rend
 /// What shading one row cost.
 #[derive(Default)]
 struct Row {
-    stats: QueryStats,
+    stats: ShadingCounters,
     points: u64,
     queries: u64,
 }
