@@ -88,5 +88,37 @@ fn compare_reports_regions_and_noise_of_sphere_renders() {
     assert!(o.status.success());
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("whole-image statistics only"), "{out}");
+
+    // A noise render of another size is named in the error, and nothing is printed as noise.
+    let small = dir.join("small.png");
+    let o = lucent(&[
+        "../scenes/sphere-shadow.toml",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--samples",
+        "1000",
+        "--quiet",
+        "-o",
+        small.to_str().unwrap(),
+        "--exr",
+        dir.join("small.exr").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = lucent(&[
+        "compare",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--noise-with",
+        small.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("small.png") && err.contains("48×48") && err.contains("96×96"),
+        "{err}"
+    );
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("seed noise"));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -118,7 +118,16 @@ pub fn compare(args: &CompareArgs) -> Result<(), String> {
     if !args.noise_with.is_empty() {
         let mut others = Vec::with_capacity(args.noise_with.len());
         for path in &args.noise_with {
-            others.push(read(path)?.image);
+            let image = read(path)?.image;
+            // Checked here so that the message names the file (the shared check cannot).
+            if image.size() != test.image.size() {
+                let ((w, h), (tw, th)) = (image.size(), test.image.size());
+                return Err(format!(
+                    "{}: {w}×{h} pixels, but the test image is {tw}×{th}: seed noise needs renders of one size",
+                    path.display()
+                ));
+            }
+            others.push(image);
         }
         let mut renders = vec![&test.image];
         renders.extend(others.iter());
