@@ -45,12 +45,13 @@ fn quick_bench_writes_a_complete_report() {
         .expect("run lucent");
     assert!(status.success(), "lucent bench --quick failed: {status}");
 
-    // One CSV row per scene × count × method (quick: 2 counts; hierarchical, LM07, N10).
+    // One CSV row per scene × count × method (quick: 2 counts; hierarchical, LM07, N10), and
+    // per scene LM07 and N10 at the sweep's other smoothing factor (k = 3).
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows.len(), 3 * 2 * 3, "{csv}");
+    assert_eq!(rows.len(), 3 * 2 * 3 + 3 * 2, "{csv}");
     let value = |row: &[&str], name: &str| -> f64 {
         row[column(&header, name)]
             .parse()
@@ -80,9 +81,16 @@ fn quick_bench_writes_a_complete_report() {
         assert!(value(row, "error_mean_rel") < 0.5, "{row:?}");
     }
     // More samples, less error: hierarchical on the sphere at 8000 beats 2000.
+    let smoothing = column(&header, "smoothing");
+    let requested = column(&header, "samples_requested");
+    assert_eq!(
+        rows.iter().filter(|r| r[smoothing] == "3").count(),
+        3 * 2,
+        "{csv}"
+    );
     let error_at = |scene: &str, method: &str, n: &str| {
         rows.iter()
-            .find(|r| r[0] == scene && r[1] == method && r[3] == n)
+            .find(|r| r[0] == scene && r[1] == method && r[requested] == n && r[smoothing] == "1.5")
             .map(|r| value(r, "error_mean_rel"))
             .unwrap_or_else(|| panic!("no row {scene} {method} {n}"))
     };
@@ -98,6 +106,7 @@ fn quick_bench_writes_a_complete_report() {
         "## Ground truth",
         "### 1. Edge-aware overhead",
         "### 2. Shadow edges",
+        "for several smoothing radii",
         "### 3. Texture-mapped",
         "### 4. Speed",
     ] {

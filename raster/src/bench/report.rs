@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::runner::{MethodSetting, RunResult};
-use super::{BenchError, BenchReport, BenchScene};
+use super::{BenchError, BenchReport, BenchScene, SmoothingRow};
 use crate::output::{OutputError, write_atomically};
 use crate::scene::SssMethod;
 
@@ -49,6 +49,72 @@ fn split(report: &BenchReport, method: SssMethod) -> MethodSetting {
     MethodSetting {
         method,
         epsilon: report.config.split_epsilon,
+    }
+}
+
+/// Claim 2 at every smoothing factor k of the sweep: the band errors, their ratio, the overall
+/// errors and edge-aware's seed noise, then each method at the k that suits it best.
+fn smoothing_sweep(report: &BenchReport, s: &mut String) {
+    if report.smoothing.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "\nThe same at {} samples for several smoothing radii α = k·√Ā (the reference sheet allows k ≈ 1–3; every other run uses the scene's k, 1.5). A larger α hands more of the sum to the noise-free local term: local-global's edge hardens, edge-aware's does not.\n\n| scene | k | edge band: local-global | edge-aware | ratio | overall: local-global | edge-aware | noise: local-global | edge-aware |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        report.config.sheet_count
+    );
+    let band = |r: &RunResult| r.edge_error.map_or(f64::NAN, |e| e.mean_relative_l1);
+    let noise = |r: &RunResult| r.noise.map_or(f64::NAN, |n| n.mean_relative);
+    for row in &report.smoothing {
+        let (l, e) = (&row.local_global, &row.edge_aware);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:.2} | {} | {} | {} | {} |",
+            row.scene.name(),
+            row.smoothing,
+            pct(band(l)),
+            pct(band(e)),
+            band(e) / band(l),
+            pct(l.error.mean_relative_l1),
+            pct(e.error.mean_relative_l1),
+            pct(noise(l)),
+            pct(noise(e)),
+        );
+    }
+    let _ = writeln!(s);
+    for &scene in &report.config.scenes {
+        let rows: Vec<&SmoothingRow> = report
+            .smoothing
+            .iter()
+            .filter(|r| r.scene == scene)
+            .collect();
+        let best = |f: fn(&SmoothingRow) -> &RunResult| {
+            rows.iter()
+                .map(|r| (r.smoothing, band(f(r))))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        let met: Vec<String> = rows
+            .iter()
+            .filter(|r| band(&r.edge_aware) <= 0.5 * band(&r.local_global))
+            .map(|r| r.smoothing.to_string())
+            .collect();
+        if let (Some((kl, bl)), Some((ke, be))) =
+            (best(|r| &r.local_global), best(|r| &r.edge_aware))
+        {
+            let _ = writeln!(
+                s,
+                "- {}: band ratio ≤ 0.5 at the same k: {}. Each at its best k: local-global {} (k = {kl}), edge-aware {} (k = {ke}), ratio {:.2}.",
+                scene.name(),
+                if met.is_empty() {
+                    "at none".to_string()
+                } else {
+                    format!("met at k = {}", met.join(", "))
+                },
+                pct(bl),
+                pct(be),
+                be / bl
+            );
+        }
     }
 }
 
@@ -142,6 +208,8 @@ fn claims(report: &BenchReport) -> String {
             }
         );
     }
+
+    smoothing_sweep(report, &mut s);
 
     let _ = writeln!(s, "\n### 3. Texture-mapped ℓ_u: the power-of-two K table\n");
     match &report.table {
@@ -306,21 +374,33 @@ pub fn write_markdown(report: &BenchReport, path: &Path) -> Result<(), BenchErro
 }
 
 /// The CSV header (one row per configuration follows).
-pub const CSV_HEADER: &str = "scene,method,epsilon,samples_requested,samples,renders,threads,total_s,prepare_s,sampling_s,irradiance_s,cache_s,raster_s,shading_s,lookups,cpu_us_per_lookup,shading_us_per_lookup,nodes_per_lookup,evaluations_per_lookup,cache_bytes,error_mean_rel,error_rmse,error_max,edge_mean_rel,edge_rmse,noise_mean_rel,noise_rms";
+pub const CSV_HEADER: &str = "scene,method,epsilon,smoothing,samples_requested,samples,renders,threads,total_s,prepare_s,sampling_s,irradiance_s,cache_s,raster_s,shading_s,lookups,cpu_us_per_lookup,shading_us_per_lookup,nodes_per_lookup,evaluations_per_lookup,cache_bytes,error_mean_rel,error_rmse,error_max,edge_mean_rel,edge_rmse,noise_mean_rel,noise_rms";
 
 /// Writes `results.csv`.
 pub fn write_csv(report: &BenchReport, path: &Path) -> Result<(), BenchError> {
     let mut s = String::new();
     let _ = writeln!(s, "{CSV_HEADER}");
     let opt = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
-    for r in &report.runs {
+    // The sweep's rows at the scene's own k are main runs already.
+    let sweep = report.smoothing.iter().flat_map(|row| {
+        [&row.local_global, &row.edge_aware]
+            .into_iter()
+            .filter(|r| {
+                !report
+                    .runs
+                    .iter()
+                    .any(|m| m.scene == r.scene && m.smoothing == r.smoothing)
+            })
+    });
+    for r in report.runs.iter().chain(sweep) {
         let t = &r.timings;
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{:e},{:e},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{:e},{:e},{},{},{},{}",
             r.scene.name(),
             crate::render::core_method(r.setting.method).name(),
             r.setting.epsilon,
+            r.smoothing,
             r.samples,
             r.placed,
             r.renders,

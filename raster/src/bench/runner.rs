@@ -104,6 +104,8 @@ pub struct RunResult {
     pub setting: MethodSetting,
     /// Samples asked for.
     pub samples: u32,
+    /// The smoothing factor k (α = k·√Ā) of the split methods.
+    pub smoothing: f32,
     /// Samples placed (first seed).
     pub placed: usize,
     /// Renders (one per seed).
@@ -241,6 +243,7 @@ pub fn run_config(
         scene,
         setting,
         samples,
+        smoothing: base.render.smoothing,
         placed: first.stats.samples,
         renders: renders.len(),
         timings: median_timings(&timings),
