@@ -272,15 +272,20 @@ fn render_in_pool(
         }
         _ => Ok(None),
     };
+    let translucent_shader = |object: usize| match prep.shader_of(object) {
+        Shader::Translucent(shader) => Some(&**shader),
+        _ => None,
+    };
     for (set, cache) in sets.iter().zip(built) {
         let alpha = cache.smoothing_radius(settings.smoothing);
         let local = local_term(set.object, alpha)?;
         cache_bytes += cache.memory_bytes();
-        caches[set.object] = Some(ObjectCache {
+        caches[set.object] = Some(ObjectCache::new(
             cache,
             alpha,
             local,
-        });
+            translucent_shader(set.object),
+        )?);
     }
     // A translucent object far smaller than the sample spacing can receive no sample at all.
     // It gets an empty cache and the smoothing radius of the shared spacing: the split methods
@@ -299,12 +304,13 @@ fn render_in_pool(
     for object in prep.translucent_objects() {
         if caches[object].is_none() {
             let alpha = settings.smoothing * spacing_area.sqrt();
-            caches[object] = Some(ObjectCache {
-                cache: IrradianceCache::build(&[])
+            caches[object] = Some(ObjectCache::new(
+                IrradianceCache::build(&[])
                     .map_err(|e| RenderError::Core(format!("empty irradiance cache: {e}")))?,
                 alpha,
-                local: local_term(object, alpha)?,
-            });
+                local_term(object, alpha)?,
+                translucent_shader(object),
+            )?);
         }
     }
     timings.cache = t.elapsed();
