@@ -26,7 +26,7 @@ use std::fmt;
 use glam::{Vec3, Vec4};
 
 use super::aabb::{Aabb, RayLanes};
-use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES, WIDE_STACK};
+use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES, SMALL_STACK, WIDE_STACK};
 use super::node::{BvhNode, WideNode};
 use super::ray::{Hit, Ray};
 
@@ -48,6 +48,9 @@ pub struct Bvh {
     pub(super) nodes: Vec<BvhNode>,
     /// The 4-wide tree's nodes, root first (empty for an empty BVH).
     pub(super) wide: Vec<WideNode>,
+    /// The most entries the traversal stack can hold on `wide` (see `build::stack_need`):
+    /// queries use a [`SMALL_STACK`]-entry stack when it fits, else a [`WIDE_STACK`] one.
+    pub(super) stack_need: u32,
     /// The triangles in leaf order.
     pub(super) triangles: Vec<[Vec3; 3]>,
     /// The input index of each slot of `triangles`.
@@ -114,8 +117,10 @@ impl Bvh {
     pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
         let built = build::build(triangles);
         let tris = built.order.iter().map(|&i| triangles[i as usize]).collect();
+        let wide = build::collapse(&built.nodes);
         Bvh {
-            wide: build::collapse(&built.nodes),
+            stack_need: build::stack_need(&wide) as u32,
+            wide,
             nodes: built.nodes,
             triangles: tris,
             ids: built.order,
@@ -213,7 +218,12 @@ impl Bvh {
         {
             return true;
         }
-        match self.any_hit(&ray, t_max) {
+        let hit = if self.stack_need as usize <= SMALL_STACK {
+            self.any_hit::<SMALL_STACK>(&ray, t_max)
+        } else {
+            self.any_hit::<WIDE_STACK>(&ray, t_max)
+        };
+        match hit {
             Some(slot) => {
                 hint.slot = slot;
                 true
@@ -223,11 +233,11 @@ impl Bvh {
     }
 
     /// The slot of some triangle hit in `(0, t_max)`, if any: depth-first over the wide tree,
-    /// testing a leaf as soon as its box is hit, stopping at the first hit.
-    fn any_hit(&self, ray: &Ray, t_max: f32) -> Option<u32> {
+    /// testing a leaf as soon as its box is hit, stopping at the first hit. `N ≥ stack_need`.
+    pub(super) fn any_hit<const N: usize>(&self, ray: &Ray, t_max: f32) -> Option<u32> {
         let lanes = RayLanes::new(ray.origin_a, ray.inv_dir);
         let limit = Vec4::splat(t_max);
-        let mut stack = [0u32; WIDE_STACK];
+        let mut stack = [0u32; N];
         let mut sp = 0;
         let mut index = 0u32;
         loop {
@@ -268,10 +278,20 @@ impl Bvh {
         if t_max.is_nan() || t_max <= 0.0 || self.wide.is_empty() {
             return None;
         }
+        if self.stack_need as usize <= SMALL_STACK {
+            self.closest_hit::<SMALL_STACK>(&ray, t_max)
+        } else {
+            self.closest_hit::<WIDE_STACK>(&ray, t_max)
+        }
+    }
+
+    /// The closest hit for [`Bvh::intersect`] (a valid ray and range, a non-empty tree).
+    /// `N ≥ stack_need`.
+    pub(super) fn closest_hit<const N: usize>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let lanes = RayLanes::new(ray.origin_a, ray.inv_dir);
         let mut best: Option<Hit> = None;
         let mut best_t = t_max;
-        let mut stack = [(0u32, 0.0f32); WIDE_STACK];
+        let mut stack = [(0u32, 0.0f32); N];
         let mut sp = 0;
         let mut index = 0u32;
         loop {
@@ -472,7 +492,8 @@ impl Bvh {
 
     /// The wide tree's invariants (see [`WideNode`]): rooted at 0, children after their
     /// parent, every node reachable once and shallower than [`MAX_DEPTH`] (so the traversal
-    /// stack of `3·MAX_DEPTH + 1` entries suffices); used lanes first, unused lanes zero; every
+    /// stack of `3·MAX_DEPTH + 1` entries suffices) and the recorded stack need right; used
+    /// lanes first, unused lanes zero; every
     /// lane box finite and inside its parent lane's box, and a leaf lane's box containing its
     /// triangles' boxes; the leaves are exactly the binary tree's leaves.
     fn validate_wide(&self) -> Result<(), InvariantError> {
@@ -553,6 +574,12 @@ impl Bvh {
                 message: format!("wide node {i} is unreachable"),
             });
         }
+        let need = build::stack_need(&self.wide);
+        ensure!(
+            need == self.stack_need as usize && need <= WIDE_STACK,
+            "traversal stack need {need} (recorded {}, at most {WIDE_STACK})",
+            self.stack_need
+        );
         let mut binary: Vec<(u32, u32)> = self
             .nodes
             .iter()

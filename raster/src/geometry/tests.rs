@@ -437,6 +437,18 @@ fn hinted_shadow_rays_match_plain_and_brute_force() {
         for &(o, d) in rays {
             let want = brute_force(tris, o, d, 1.0).is_some();
             assert_eq!(bvh.occluded(o, d, 1.0), want, "scene {k} ray {o} {d}");
+            // The full-size stack (used for trees too deep and bushy for the small one) gives
+            // the same answers.
+            assert!(bvh.stack_need as usize <= build::SMALL_STACK);
+            let ray = Ray::new(o, d).unwrap();
+            assert_eq!(
+                bvh.any_hit::<{ build::WIDE_STACK }>(&ray, 1.0).is_some(),
+                want
+            );
+            assert_eq!(
+                bvh.closest_hit::<{ build::WIDE_STACK }>(&ray, f32::INFINITY),
+                bvh.intersect(o, d, f32::INFINITY)
+            );
             let before = carried;
             assert_eq!(bvh.occluded_hinted(o, d, 1.0, &mut carried), want);
             if want {
@@ -480,7 +492,8 @@ fn validate_catches_broken_wide_trees() {
     good.validate().unwrap();
     assert!(good.wide.len() > 10 && good.wide.len() * 2 < good.nodes.len());
     type Breakage = (&'static str, fn(&mut Bvh));
-    let breakages: [Breakage; 6] = [
+    let breakages: [Breakage; 7] = [
+        ("stack need understated", |b| b.stack_need -= 1),
         ("shrunk lane box", |b| {
             b.wide[3].max[0][0] = b.wide[3].min[0][0] - 1.0
         }),
