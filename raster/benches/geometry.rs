@@ -2,16 +2,22 @@
 //!
 //! Run: `cargo bench -p lucent-raster --bench geometry`.
 //!
-//! The scene: a unit icosphere (6 subdivisions, 81,920 triangles) above a 6×6 floor of 20,000
-//! triangles: 101,920 triangles.
+//! The random-ray scene: a unit icosphere (6 subdivisions, 81,920 triangles) above a 6×6 floor
+//! of 20,000 triangles: 101,920 triangles.
+//!
+//! The coherent scene is `scenes/sphere-shadow.toml`: a 128-segment UV sphere (16,128
+//! triangles) on a floor, half shadowed by a thin plate, and shadow rays from its lit side to
+//! the point light in scanline order, as a renderer traces them.
 
 use divan::counter::ItemsCount;
 use divan::{Bencher, black_box};
 use glam::Vec3;
 use lucent_raster::geometry::shapes::{grid, icosphere};
-use lucent_raster::geometry::{Bvh, offset_origin};
+use lucent_raster::geometry::{Bvh, ShadowHint, offset_origin};
 use lucent_raster::sampling::rng::Pcg32;
 use lucent_raster::sampling::{SampleTarget, poisson_samples};
+use lucent_raster::scene::Mesh;
+use lucent_raster::scene::shapes::{cuboid, plane, sphere};
 
 fn main() {
     divan::main();
@@ -49,6 +55,66 @@ fn shadow_rays(tris: &[[Vec3; 3]], bvh: &Bvh, n: usize) -> Vec<(Vec3, Vec3)> {
         .collect()
 }
 
+/// The triangles of `mesh` moved by `offset`.
+fn placed(mesh: &Mesh, offset: Vec3) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+    mesh.triangles
+        .iter()
+        .map(move |t| t.map(|i| mesh.positions[i as usize] + offset))
+}
+
+/// `scenes/sphere-shadow.toml`'s geometry: sphere, floor, plate. Returns the triangles and the
+/// number of sphere triangles (they come first).
+fn sphere_shadow_scene() -> (Vec<[Vec3; 3]>, usize) {
+    let mut tris: Vec<[Vec3; 3]> = placed(&sphere(1.0, 128), Vec3::new(0.0, 0.0, 1.0)).collect();
+    let n_sphere = tris.len();
+    tris.extend(placed(
+        &plane(glam::Vec2::new(40.0, 60.0)),
+        Vec3::new(0.0, 24.0, 0.0),
+    ));
+    tris.extend(placed(
+        &cuboid(Vec3::new(3.0, 7.6, 0.05)),
+        Vec3::new(-1.5, 0.2, 2.6),
+    ));
+    (tris, n_sphere)
+}
+
+/// Shadow rays of the coherent scene: a 256×256 pinhole camera at the scene's position looks
+/// at the sphere; every pixel whose primary ray hits the sphere on its light-facing side
+/// gives one shadow ray (offset along the face normal) to the point light, in scanline order.
+/// About half are blocked by the plate.
+fn coherent_shadow_rays(tris: &[[Vec3; 3]], n_sphere: usize, bvh: &Bvh) -> Vec<(Vec3, Vec3)> {
+    let light = Vec3::new(0.0, -3.0, 5.0);
+    let eye = Vec3::new(0.0, -7.0, 1.3);
+    let forward = (Vec3::new(0.0, 0.0, 0.9) - eye).normalize();
+    let right = forward.cross(Vec3::Z).normalize();
+    let up = right.cross(forward);
+    let half = (15.0f32).to_radians().tan();
+    let side = 256;
+    let mut rays = Vec::new();
+    for y in 0..side {
+        for x in 0..side {
+            let sx = ((x as f32 + 0.5) / side as f32 * 2.0 - 1.0) * half;
+            let sy = (1.0 - (y as f32 + 0.5) / side as f32 * 2.0) * half;
+            let d = forward + right * sx + up * sy;
+            let Some(hit) = bvh.intersect(eye, d, f32::INFINITY) else {
+                continue;
+            };
+            if hit.triangle as usize >= n_sphere {
+                continue;
+            }
+            let t = &tris[hit.triangle as usize];
+            let p = eye + d * hit.t;
+            let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+            if n.dot(light - p) <= 0.0 {
+                continue;
+            }
+            let o = offset_origin(p, n, bvh.scale());
+            rays.push((o, light - o));
+        }
+    }
+    rays
+}
+
 #[divan::bench(sample_count = 20)]
 fn bvh_build(bencher: Bencher) {
     let tris = scene();
@@ -77,6 +143,37 @@ fn intersect(bencher: Bencher) {
     bencher.counter(ItemsCount::new(rays.len())).bench(|| {
         rays.iter()
             .filter_map(|&(o, d)| bvh.intersect(o, d, f32::INFINITY))
+            .count()
+    });
+}
+
+#[divan::bench(sample_count = 40)]
+fn occluded_coherent(bencher: Bencher) {
+    let (tris, n_sphere) = sphere_shadow_scene();
+    let bvh = Bvh::build(&tris);
+    let rays = coherent_shadow_rays(&tris, n_sphere, &bvh);
+    // The bench means what it says only if the plate blocks about half the rays.
+    let blocked = rays
+        .iter()
+        .filter(|&&(o, d)| bvh.occluded(o, d, 1.0))
+        .count();
+    assert!(rays.len() > 5_000 && (blocked * 10).abs_diff(rays.len() * 5) < rays.len() * 2);
+    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
+        rays.iter()
+            .filter(|&&(o, d)| bvh.occluded(o, d, 1.0))
+            .count()
+    });
+}
+
+#[divan::bench(sample_count = 40)]
+fn occluded_coherent_hinted(bencher: Bencher) {
+    let (tris, n_sphere) = sphere_shadow_scene();
+    let bvh = Bvh::build(&tris);
+    let rays = coherent_shadow_rays(&tris, n_sphere, &bvh);
+    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
+        let mut hint = ShadowHint::default();
+        rays.iter()
+            .filter(|&&(o, d)| bvh.occluded_hinted(o, d, 1.0, &mut hint))
             .count()
     });
 }

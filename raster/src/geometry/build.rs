@@ -16,12 +16,16 @@
 use glam::Vec3;
 
 use super::aabb::Aabb;
-use super::node::BvhNode;
+use super::node::{BvhNode, WideNode};
 
 /// Centroid bins per axis. Wald 2007 found 16–32 bins within a few percent of a full sweep.
 pub(super) const BINS: usize = 16;
 /// Most triangles in one leaf.
 pub(super) const MAX_LEAF: u32 = 8;
+const _: () = assert!(
+    MAX_LEAF <= u8::MAX as u32,
+    "WideNode stores leaf sizes in a u8"
+);
 /// Depth from which splits are object medians (see the module documentation).
 pub(super) const MEDIAN_DEPTH: u32 = 32;
 /// Bound on the depth of any node (root = 0), and the size of the traversal stack.
@@ -33,6 +37,15 @@ pub(super) const MAX_TRIANGLES: usize = 1 << 31;
 /// sizes 1.1, 1.8, 2.9 and 5.8 triangles, shadow-ray times within 7% of each other (noise on
 /// this machine); 1 builds a mid-sized tree.
 const TRAVERSAL_COST: f32 = 1.0;
+
+/// Entries of the 4-wide traversal stack that suffice for any tree: each node visit pops one
+/// entry and pushes at most four, and the wide tree is no deeper than the binary one
+/// (`MAX_DEPTH`).
+pub(super) const WIDE_STACK: usize = 3 * MAX_DEPTH as usize + 1;
+/// The stack the traversals use when the tree's [`stack_need`] allows (every tree of up to
+/// millions of well-spread triangles): zeroing the full [`WIDE_STACK`] for every ray cost
+/// 10–15% of a coherent shadow ray.
+pub(super) const SMALL_STACK: usize = 32;
 
 /// What the builder returns: the node array and, per leaf slot, the input triangle index.
 pub(super) struct Built {
@@ -252,4 +265,87 @@ impl Builder<'_> {
         }
         best
     }
+}
+
+/// Collapses the binary tree into the 4-wide one that queries traverse. Each wide node takes
+/// the two children of a binary node and, while it has fewer than four lanes, replaces the
+/// interior lane of largest surface area by that node's two children (the first one on a
+/// tie), as in Wald, Benthin & Boulos 2008: big boxes are the ones most rays enter, so opening
+/// them saves the most visits. Leaves are the binary tree's leaves, unchanged. Lanes keep the
+/// binary tree's left-to-right order; the children of one wide node get consecutive indices.
+/// Deterministic, O(N).
+pub(super) fn collapse(nodes: &[BvhNode]) -> Vec<WideNode> {
+    let mut wide = Vec::new();
+    let Some(root) = nodes.first() else {
+        return wide;
+    };
+    wide.reserve(nodes.len() / 3 + 1);
+    wide.push(WideNode::EMPTY);
+    if root.is_leaf() {
+        wide[0].set_lane(0, &root.bounds(), root.first, root.count as u8);
+        return wide;
+    }
+    let mut stack = vec![(0u32, 0u32)];
+    while let Some((binary, index)) = stack.pop() {
+        let first = nodes[binary as usize].first;
+        let mut lanes = [first, first + 1, 0, 0];
+        let mut len = 2;
+        while len < 4 {
+            let mut widest: Option<(usize, f32)> = None;
+            for (i, &n) in lanes[..len].iter().enumerate() {
+                let node = &nodes[n as usize];
+                if node.is_leaf() {
+                    continue;
+                }
+                let area = node.bounds().half_area();
+                if widest.is_none_or(|(_, a)| area > a) {
+                    widest = Some((i, area));
+                }
+            }
+            let Some((i, _)) = widest else { break };
+            let first = nodes[lanes[i] as usize].first;
+            lanes.copy_within(i + 1..len, i + 2);
+            lanes[i] = first;
+            lanes[i + 1] = first + 1;
+            len += 1;
+        }
+        let mut node = WideNode::EMPTY;
+        for (lane, &n) in lanes[..len].iter().enumerate() {
+            let child = &nodes[n as usize];
+            if child.is_leaf() {
+                node.set_lane(lane, &child.bounds(), child.first, child.count as u8);
+            } else {
+                let at = wide.len() as u32;
+                wide.push(WideNode::EMPTY);
+                node.set_lane(lane, &child.bounds(), at, 0);
+                stack.push((n, at));
+            }
+        }
+        wide[index as usize] = node;
+    }
+    wide
+}
+
+/// The most entries the traversal stack of `Bvh`'s queries can hold on `wide`: a visit to a
+/// node pushes its interior lanes on top of what its ancestors left, and a child is visited
+/// with its parent's entries less the one popped to reach it. At most [`WIDE_STACK`].
+pub(super) fn stack_need(wide: &[WideNode]) -> usize {
+    if wide.is_empty() {
+        return 0;
+    }
+    let interior = |n: &WideNode| (0..n.len()).filter(|&l| n.count[l] == 0).count();
+    let mut need = 0;
+    // (node, entries on the stack when it is visited)
+    let mut stack = vec![(0u32, 0usize)];
+    while let Some((index, base)) = stack.pop() {
+        let node = &wide[index as usize];
+        let pushed = interior(node);
+        need = need.max(base + pushed);
+        for lane in 0..node.len() {
+            if node.count[lane] == 0 {
+                stack.push((node.child[lane], base + pushed - 1));
+            }
+        }
+    }
+    need
 }

@@ -1,27 +1,33 @@
 //! The bounding volume hierarchy over world-space triangles, and its two queries: any hit
 //! (shadow rays) and closest hit.
 //!
-//! Layout: a flat array of 32-byte [`BvhNode`]s (root at index 0, siblings adjacent), and the
-//! triangles copied into leaf order so a leaf's triangles are contiguous:
+//! Layout: the binary tree the builder makes, a flat array of 32-byte [`BvhNode`]s (root at
+//! index 0, siblings adjacent); the same tree collapsed to a 4-wide one, a flat array of
+//! 128-byte [`WideNode`]s (each holding its up-to-four children's boxes), which the queries
+//! traverse; and the triangles copied into leaf order so a leaf's triangles are contiguous.
+//! Both trees have the same leaves.
 //!
 //! ```text
 //! nodes:      [ root | L | R | LL | LR | RL | RR | ... ]     (BvhNode, 32 bytes each)
+//! wide:       [ root: LL LR RL RR | LL: ... | ... ]           (WideNode, 128 bytes each)
 //! triangles:  [ tri  | tri | tri | ... ]                     ([Vec3; 3] in leaf order)
 //! ids:        [ 17   | 3   | 254 | ... ]                     (input index of each slot)
 //! ```
 //!
-//! Traversal is depth-first with a fixed stack of [`MAX_DEPTH`] entries (the builder bounds the
-//! depth); closest-hit visits the nearer child first and skips subtrees entered beyond the best
-//! hit so far. Box tests are conservative (see [`slab_test`]) and the triangle test is
-//! watertight (see [`Ray`]), so a closed mesh has no cracks for rays to slip through.
+//! Traversal is depth-first over the wide tree with a fixed stack (the builder bounds the
+//! depth); each visit tests a node's four boxes at once and a leaf's triangles as soon as its
+//! box is hit. Closest-hit visits the nearer children first and skips subtrees entered beyond
+//! the best hit so far. Box tests are conservative (see [`RayLanes::slab_test`]) and the
+//! triangle test is watertight (see [`Ray`]), so a closed mesh has no cracks for rays to slip
+//! through.
 
 use std::fmt;
 
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec4};
 
-use super::aabb::{Aabb, slab_test};
-use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES};
-use super::node::BvhNode;
+use super::aabb::{Aabb, RayLanes};
+use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES, SMALL_STACK, WIDE_STACK};
+use super::node::{BvhNode, WideNode};
 use super::ray::{Hit, Ray};
 
 /// A BVH over triangles, for shadow rays and closest-hit queries.
@@ -38,8 +44,13 @@ use super::ray::{Hit, Ray};
 /// ```
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    /// The nodes, root first (empty for an empty BVH).
+    /// The binary tree's nodes, root first (empty for an empty BVH).
     pub(super) nodes: Vec<BvhNode>,
+    /// The 4-wide tree's nodes, root first (empty for an empty BVH).
+    pub(super) wide: Vec<WideNode>,
+    /// The most entries the traversal stack can hold on `wide` (see `build::stack_need`):
+    /// queries use a [`SMALL_STACK`]-entry stack when it fits, else a [`WIDE_STACK`] one.
+    pub(super) stack_need: u32,
     /// The triangles in leaf order.
     pub(super) triangles: Vec<[Vec3; 3]>,
     /// The input index of each slot of `triangles`.
@@ -48,6 +59,31 @@ pub struct Bvh {
     pub(super) skipped: Vec<u32>,
     /// How many input triangles were looked at.
     pub(super) source_len: u32,
+}
+
+/// Which triangle blocked the previous shadow ray, for [`Bvh::occluded_hinted`]. Small and
+/// `Copy`: keep one per light in each thread's loop over pixels. The default names no
+/// triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowHint {
+    /// Leaf-order slot of the last occluder found, `u32::MAX` for none.
+    pub(super) slot: u32,
+}
+
+impl ShadowHint {
+    /// The hint that names no triangle.
+    pub const NONE: ShadowHint = ShadowHint { slot: u32::MAX };
+
+    /// The leaf-order slot of the last occluder found, if any.
+    pub fn slot(&self) -> Option<u32> {
+        (self.slot != u32::MAX).then_some(self.slot)
+    }
+}
+
+impl Default for ShadowHint {
+    fn default() -> Self {
+        ShadowHint::NONE
+    }
 }
 
 /// A broken invariant found by [`Bvh::validate`].
@@ -81,7 +117,10 @@ impl Bvh {
     pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
         let built = build::build(triangles);
         let tris = built.order.iter().map(|&i| triangles[i as usize]).collect();
+        let wide = build::collapse(&built.nodes);
         Bvh {
+            stack_need: build::stack_need(&wide) as u32,
+            wide,
             nodes: built.nodes,
             triangles: tris,
             ids: built.order,
@@ -105,9 +144,14 @@ impl Bvh {
         &self.skipped
     }
 
-    /// The node array (root first), for inspection and statistics.
+    /// The binary tree's node array (root first), for inspection and statistics.
     pub fn nodes(&self) -> &[BvhNode] {
         &self.nodes
+    }
+
+    /// The 4-wide tree's node array (root first) that the queries traverse.
+    pub fn wide_nodes(&self) -> &[WideNode] {
+        &self.wide
     }
 
     /// Bounds of every triangle ([`Aabb::EMPTY`] when empty).
@@ -130,65 +174,95 @@ impl Bvh {
     /// first hit found. A non-finite origin or direction, a zero direction, or `t_max ≤ 0` (or
     /// NaN) is never occluded; `t_max = ∞` asks about the whole ray.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        let mut throwaway = ShadowHint::NONE;
+        self.occluded_hinted(origin, dir, t_max, &mut throwaway)
+    }
+
+    /// [`Bvh::occluded`], trying the triangle in `hint` first and recording in it the occluder
+    /// found. The answer is always exactly that of `occluded` (any triangle hit in
+    /// `(0, t_max)` means occluded, so which one is tested first cannot change it); only the
+    /// time differs. Neighbouring shadow rays towards the same light are mostly blocked by the
+    /// same triangle, so a renderer that keeps one hint per light (and per thread) while it
+    /// walks the pixels in order answers most blocked rays with one triangle test instead of a
+    /// traversal. A miss leaves the hint as it is. A hint from another BVH is harmless: it
+    /// names a triangle of this one or none.
+    ///
+    /// ```
+    /// use glam::Vec3;
+    /// use lucent_raster::geometry::{Bvh, ShadowHint};
+    ///
+    /// let floor = [[Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)]];
+    /// let bvh = Bvh::build(&floor);
+    /// let mut hint = ShadowHint::default();
+    /// for x in [-0.2, -0.1, 0.0, 0.1] {
+    ///     let origin = Vec3::new(x, 0.0, 1.0);
+    ///     assert!(bvh.occluded_hinted(origin, -Vec3::Z, 2.0, &mut hint));
+    /// }
+    /// assert_eq!(hint.slot(), Some(0));
+    /// ```
+    pub fn occluded_hinted(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        hint: &mut ShadowHint,
+    ) -> bool {
         let Some(ray) = Ray::new(origin, dir) else {
             return false;
         };
-        if t_max.is_nan() || t_max <= 0.0 || self.nodes.is_empty() {
+        if t_max.is_nan() || t_max <= 0.0 || self.wide.is_empty() {
             return false;
         }
-        let visit = |n: &BvhNode| {
-            slab_test(
-                Vec3A::from_array(n.min),
-                Vec3A::from_array(n.max),
-                ray.origin_a,
-                ray.inv_dir,
-                t_max,
-            )
+        if let Some(tri) = self.triangles.get(hint.slot as usize)
+            && ray.intersect_triangle(tri, t_max).is_some()
+        {
+            return true;
+        }
+        let hit = if self.stack_need as usize <= SMALL_STACK {
+            self.any_hit::<SMALL_STACK>(&ray, t_max)
+        } else {
+            self.any_hit::<WIDE_STACK>(&ray, t_max)
         };
-        if visit(&self.nodes[0]).is_none() {
-            return false;
+        match hit {
+            Some(slot) => {
+                hint.slot = slot;
+                true
+            }
+            None => false,
         }
-        let mut stack = [0u32; MAX_DEPTH as usize];
+    }
+
+    /// The slot of some triangle hit in `(0, t_max)`, if any: depth-first over the wide tree,
+    /// testing a leaf as soon as its box is hit, stopping at the first hit. `N ≥ stack_need`.
+    pub(super) fn any_hit<const N: usize>(&self, ray: &Ray, t_max: f32) -> Option<u32> {
+        let lanes = RayLanes::new(ray.origin_a, ray.inv_dir);
+        let limit = Vec4::splat(t_max);
+        let mut stack = [0u32; N];
         let mut sp = 0;
         let mut index = 0u32;
         loop {
-            let node = &self.nodes[index as usize];
-            if node.count > 0 {
-                let slots = node.first as usize..(node.first + node.count) as usize;
-                for tri in &self.triangles[slots] {
-                    if ray.intersect_triangle(tri, t_max).is_some() {
-                        return true;
-                    }
+            let node = &self.wide[index as usize];
+            let (mut mask, _) = lanes.slab_test(node, limit);
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let (child, count) = (node.child[lane], node.count[lane] as u32);
+                if count == 0 {
+                    stack[sp] = child;
+                    sp += 1;
+                    continue;
                 }
-            } else {
-                let left = node.first;
-                let hit_l = visit(&self.nodes[left as usize]);
-                let hit_r = visit(&self.nodes[left as usize + 1]);
-                match (hit_l, hit_r) {
-                    (Some(tl), Some(tr)) => {
-                        let (near, far) = if tl <= tr {
-                            (left, left + 1)
-                        } else {
-                            (left + 1, left)
-                        };
-                        stack[sp] = far;
-                        sp += 1;
-                        index = near;
-                        continue;
+                for slot in child..child + count {
+                    if ray
+                        .intersect_triangle(&self.triangles[slot as usize], t_max)
+                        .is_some()
+                    {
+                        return Some(slot);
                     }
-                    (Some(_), None) => {
-                        index = left;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        index = left + 1;
-                        continue;
-                    }
-                    (None, None) => {}
                 }
             }
             if sp == 0 {
-                return false;
+                return None;
             }
             sp -= 1;
             index = stack[sp];
@@ -201,27 +275,56 @@ impl Bvh {
     /// [`Bvh::occluded`]) hit nothing.
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
         let ray = Ray::new(origin, dir)?;
-        if t_max.is_nan() || t_max <= 0.0 || self.nodes.is_empty() {
+        if t_max.is_nan() || t_max <= 0.0 || self.wide.is_empty() {
             return None;
         }
-        let visit = |n: &BvhNode, limit: f32| {
-            slab_test(
-                Vec3A::from_array(n.min),
-                Vec3A::from_array(n.max),
-                ray.origin_a,
-                ray.inv_dir,
-                limit,
-            )
-        };
-        visit(&self.nodes[0], t_max)?;
+        if self.stack_need as usize <= SMALL_STACK {
+            self.closest_hit::<SMALL_STACK>(&ray, t_max)
+        } else {
+            self.closest_hit::<WIDE_STACK>(&ray, t_max)
+        }
+    }
+
+    /// The closest hit for [`Bvh::intersect`] (a valid ray and range, a non-empty tree).
+    /// `N ≥ stack_need`.
+    pub(super) fn closest_hit<const N: usize>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let lanes = RayLanes::new(ray.origin_a, ray.inv_dir);
         let mut best: Option<Hit> = None;
         let mut best_t = t_max;
-        let mut stack = [(0u32, 0.0f32); MAX_DEPTH as usize];
+        let mut stack = [(0u32, 0.0f32); N];
         let mut sp = 0;
         let mut index = 0u32;
         loop {
-            let node = &self.nodes[index as usize];
-            if node.count > 0 {
+            let node = &self.wide[index as usize];
+            let (mut mask, near) = lanes.slab_test(node, Vec4::splat(best_t));
+            let near = near.to_array();
+            // The lanes hit, nearest first (at most four: insertion sort).
+            let mut order = [0usize; 4];
+            let mut n = 0;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let mut k = n;
+                while k > 0 && near[order[k - 1]] > near[lane] {
+                    order[k] = order[k - 1];
+                    k -= 1;
+                }
+                order[k] = lane;
+                n += 1;
+            }
+            // Leaves are tested now, nearest first; interior children are pushed farthest
+            // first, so the nearest is popped next.
+            for &lane in order[..n].iter().rev() {
+                if node.count[lane] == 0 {
+                    stack[sp] = (node.child[lane], near[lane]);
+                    sp += 1;
+                }
+            }
+            for &lane in &order[..n] {
+                let count = node.count[lane] as usize;
+                if count == 0 || near[lane] > best_t {
+                    continue;
+                }
                 // Equal t must still be considered for the tie-break, so the limit is the next
                 // float above the best t once there is one.
                 let limit = if best.is_some() {
@@ -229,11 +332,8 @@ impl Bvh {
                 } else {
                     t_max
                 };
-                let first = node.first as usize;
-                for (k, tri) in self.triangles[first..first + node.count as usize]
-                    .iter()
-                    .enumerate()
-                {
+                let first = node.child[lane] as usize;
+                for (k, tri) in self.triangles[first..first + count].iter().enumerate() {
                     if let Some((t, u, v)) = ray.intersect_triangle(tri, limit) {
                         let id = self.ids[first + k];
                         if best.is_none_or(|b| t < b.t || (t == b.t && id < b.triangle)) {
@@ -246,32 +346,6 @@ impl Bvh {
                             best_t = t;
                         }
                     }
-                }
-            } else {
-                let left = node.first;
-                let hit_l = visit(&self.nodes[left as usize], best_t);
-                let hit_r = visit(&self.nodes[left as usize + 1], best_t);
-                match (hit_l, hit_r) {
-                    (Some(tl), Some(tr)) => {
-                        let ((near, _), far) = if tl <= tr {
-                            ((left, tl), (left + 1, tr))
-                        } else {
-                            ((left + 1, tr), (left, tl))
-                        };
-                        stack[sp] = far;
-                        sp += 1;
-                        index = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        index = left;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        index = left + 1;
-                        continue;
-                    }
-                    (None, None) => {}
                 }
             }
             // Pop the next subtree that may still hold a hit no farther than the best one.
@@ -413,6 +487,113 @@ impl Bvh {
                 message: format!("slot {slot} is in no leaf"),
             });
         }
+        self.validate_wide()
+    }
+
+    /// The wide tree's invariants (see [`WideNode`]): rooted at 0, children after their
+    /// parent, every node reachable once and shallower than [`MAX_DEPTH`] (so the traversal
+    /// stack of `3·MAX_DEPTH + 1` entries suffices) and the recorded stack need right; used
+    /// lanes first, unused lanes zero; every
+    /// lane box finite and inside its parent lane's box, and a leaf lane's box containing its
+    /// triangles' boxes; the leaves are exactly the binary tree's leaves.
+    fn validate_wide(&self) -> Result<(), InvariantError> {
+        ensure!(
+            self.wide.is_empty() == self.nodes.is_empty(),
+            "{} wide nodes for {} binary nodes",
+            self.wide.len(),
+            self.nodes.len()
+        );
+        if self.wide.is_empty() {
+            return Ok(());
+        }
+        let n_tris = self.triangles.len();
+        let mut visited = vec![false; self.wide.len()];
+        let mut leaves = Vec::new();
+        let mut stack: Vec<(u32, u32, Option<Aabb>)> = vec![(0, 0, None)];
+        while let Some((index, depth, parent)) = stack.pop() {
+            ensure!(
+                depth < MAX_DEPTH,
+                "wide node {index} at depth {depth} exceeds the traversal stack"
+            );
+            ensure!(!visited[index as usize], "wide node {index} reached twice");
+            visited[index as usize] = true;
+            let node = &self.wide[index as usize];
+            ensure!(
+                matches!(node.valid, 0b1 | 0b11 | 0b111 | 0b1111),
+                "wide node {index} has lane mask {:#06b}",
+                node.valid
+            );
+            for lane in 0..4 {
+                let (child, count) = (node.child[lane], node.count[lane]);
+                let bounds = node.lane_bounds(lane);
+                if node.valid & (1 << lane) == 0 {
+                    ensure!(
+                        child == 0
+                            && count == 0
+                            && bounds.min == Vec3::ZERO
+                            && bounds.max == Vec3::ZERO,
+                        "wide node {index}: unused lane {lane} is not zero"
+                    );
+                    continue;
+                }
+                ensure!(
+                    bounds.is_finite() && !bounds.is_empty(),
+                    "wide node {index} lane {lane} has bounds {bounds:?}"
+                );
+                if let Some(p) = parent {
+                    ensure!(
+                        p.contains(&bounds),
+                        "wide node {index} lane {lane} bounds {bounds:?} escape the parent's {p:?}"
+                    );
+                }
+                if count > 0 {
+                    let (first, end) = (child as usize, child as usize + count as usize);
+                    ensure!(
+                        count as u32 <= MAX_LEAF && end <= n_tris,
+                        "wide node {index} lane {lane} covers slots {first}..{end} of {n_tris}"
+                    );
+                    for (slot, tri) in self.triangles.iter().enumerate().take(end).skip(first) {
+                        let tb = Aabb::from_triangle(tri);
+                        ensure!(
+                            bounds.contains(&tb),
+                            "wide node {index} lane {lane} bounds {bounds:?} miss slot {slot} box {tb:?}"
+                        );
+                    }
+                    leaves.push((child, count as u32));
+                } else {
+                    ensure!(
+                        child > index && (child as usize) < self.wide.len(),
+                        "wide node {index} lane {lane} has child {child}"
+                    );
+                    stack.push((child, depth + 1, Some(bounds)));
+                }
+            }
+        }
+        if let Some(i) = visited.iter().position(|&v| !v) {
+            return Err(InvariantError {
+                message: format!("wide node {i} is unreachable"),
+            });
+        }
+        let need = build::stack_need(&self.wide);
+        ensure!(
+            need == self.stack_need as usize && need <= WIDE_STACK,
+            "traversal stack need {need} (recorded {}, at most {WIDE_STACK})",
+            self.stack_need
+        );
+        let mut binary: Vec<(u32, u32)> = self
+            .nodes
+            .iter()
+            .filter(|n| n.is_leaf())
+            .map(|n| (n.first, n.count))
+            .collect();
+        binary.sort_unstable();
+        leaves.sort_unstable();
+        ensure!(
+            leaves == binary,
+            "the wide tree's {} leaves are not the binary tree's {}",
+            leaves.len(),
+            binary.len()
+        );
         Ok(())
     }
 }

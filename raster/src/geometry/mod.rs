@@ -2,7 +2,9 @@
 //!
 //! The renderer asks one question many times: is the segment from a surface point to a light
 //! blocked? [`Bvh::build`] builds a compact binned-SAH hierarchy over the scene's world-space
-//! triangles once; [`Bvh::occluded`] answers that question (any hit, early exit) and
+//! triangles once; [`Bvh::occluded`] answers that question (any hit, early exit),
+//! [`Bvh::occluded_hinted`] answers it faster for coherent rays by trying the last occluder
+//! first, and
 //! [`Bvh::intersect`] finds the closest hit. Shadow rays start at [`offset_origin`] so they do
 //! not hit the triangle they leave.
 //!
@@ -14,8 +16,8 @@
 //! |---|---|
 //! | `aabb.rs` | boxes and the slab test |
 //! | `ray.rs` | prepared rays, the watertight triangle test, hits, origin offset |
-//! | `node.rs` | the 32-byte node |
-//! | `build.rs` | binned SAH construction |
+//! | `node.rs` | the 32-byte binary node and the 128-byte 4-wide node |
+//! | `build.rs` | binned SAH construction, collapse to the 4-wide tree |
 //! | `bvh.rs` | the BVH, its queries and `validate` |
 //! | `shapes.rs` | procedural meshes for tests and benchmarks |
 
@@ -27,8 +29,8 @@ mod ray;
 pub mod shapes;
 
 pub use aabb::Aabb;
-pub use bvh::{Bvh, InvariantError};
-pub use node::BvhNode;
+pub use bvh::{Bvh, InvariantError, ShadowHint};
+pub use node::{BvhNode, WideNode};
 pub use ray::{Hit, OFFSET_RELATIVE, Ray, offset_origin};
 
 #[cfg(test)]

@@ -365,3 +365,179 @@ fn offset_shadow_rays_do_not_hit_their_own_surface() {
         );
     }
 }
+
+/// The geometry of `scenes/sphere-shadow.toml` (sphere, floor, plate) and shadow rays to its
+/// light from a grid over the sphere's light-facing side, in scanline order: coherent rays,
+/// about half of them blocked by the plate.
+fn sphere_shadow_rays() -> (Vec<[Vec3; 3]>, Vec<(Vec3, Vec3)>) {
+    use crate::scene::shapes::{cuboid, plane, sphere};
+    let placed = |m: crate::scene::Mesh, at: Vec3| -> Vec<[Vec3; 3]> {
+        m.triangles
+            .iter()
+            .map(|t| t.map(|i| m.positions[i as usize] + at))
+            .collect()
+    };
+    let center = Vec3::new(0.0, 0.0, 1.0);
+    let mut tris = placed(sphere(1.0, 48), center);
+    tris.extend(placed(
+        plane(glam::Vec2::new(40.0, 60.0)),
+        Vec3::new(0.0, 24.0, 0.0),
+    ));
+    tris.extend(placed(
+        cuboid(Vec3::new(3.0, 7.6, 0.05)),
+        Vec3::new(-1.5, 0.2, 2.6),
+    ));
+    let light = Vec3::new(0.0, -3.0, 5.0);
+    let to_light = (light - center).normalize();
+    let u = to_light.cross(Vec3::Z).normalize();
+    let v = u.cross(to_light);
+    let scale = Bvh::build(&tris).scale();
+    let mut rays = Vec::new();
+    let side = 60;
+    for j in 0..side {
+        for i in 0..side {
+            let s = (i as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            let t = (j as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            if s * s + t * t >= 0.98 {
+                continue;
+            }
+            let n = u * s + v * t + to_light * (1.0 - s * s - t * t).sqrt();
+            // Just outside the facets (the mesh is inscribed: 0.2% inside the sphere at most).
+            let o = offset_origin(center + n * 1.003, n, scale);
+            rays.push((o, light - o));
+        }
+    }
+    (tris, rays)
+}
+
+#[test]
+fn hinted_shadow_rays_match_plain_and_brute_force() {
+    let mut rng = Pcg32::new(77, 3);
+    let (sphere_scene, coherent) = sphere_shadow_rays();
+    let mut scenes = vec![(sphere_scene, coherent)];
+    for n in [1usize, 40, 2000] {
+        let tris = random_scene(&mut rng, n);
+        let rays = (0..3000)
+            .map(|_| {
+                let o = random_point(&mut rng, -14.0, 14.0);
+                let t = &tris[rng.next_below(tris.len() as u32) as usize];
+                let aim = (t[0] + t[1] + t[2]) / 3.0 + random_point(&mut rng, -0.5, 0.5);
+                (o, (aim - o) * (0.5 + rng.next_f32()))
+            })
+            .collect();
+        scenes.push((tris, rays));
+    }
+    for (k, (tris, rays)) in scenes.iter().enumerate() {
+        let bvh = Bvh::build(tris);
+        check(&bvh, tris);
+        // One hint carried along the rays (as a renderer would), and fresh hints naming a
+        // random slot, an out-of-range slot and nothing.
+        let mut carried = ShadowHint::default();
+        let (mut blocked, mut repeated) = (0, 0);
+        for &(o, d) in rays {
+            let want = brute_force(tris, o, d, 1.0).is_some();
+            assert_eq!(bvh.occluded(o, d, 1.0), want, "scene {k} ray {o} {d}");
+            // The full-size stack (used for trees too deep and bushy for the small one) gives
+            // the same answers.
+            assert!(bvh.stack_need as usize <= build::SMALL_STACK);
+            let ray = Ray::new(o, d).unwrap();
+            assert_eq!(
+                bvh.any_hit::<{ build::WIDE_STACK }>(&ray, 1.0).is_some(),
+                want
+            );
+            assert_eq!(
+                bvh.closest_hit::<{ build::WIDE_STACK }>(&ray, f32::INFINITY),
+                bvh.intersect(o, d, f32::INFINITY)
+            );
+            let before = carried;
+            assert_eq!(bvh.occluded_hinted(o, d, 1.0, &mut carried), want);
+            if want {
+                blocked += 1;
+                // The hint names a triangle that blocks this ray.
+                let slot = carried.slot().expect("an occluded ray sets the hint") as usize;
+                let ray = Ray::new(o, d).unwrap();
+                assert!(ray.intersect_triangle(&bvh.triangles[slot], 1.0).is_some());
+                repeated += usize::from(carried == before);
+            } else {
+                assert_eq!(carried, before, "a miss leaves the hint alone");
+            }
+            for slot in [rng.next_below(tris.len() as u32 + 5), u32::MAX - 1] {
+                let mut hint = ShadowHint { slot };
+                assert_eq!(bvh.occluded_hinted(o, d, 1.0, &mut hint), want);
+            }
+            let mut fresh = ShadowHint::NONE;
+            assert_eq!(bvh.occluded_hinted(o, d, 1.0, &mut fresh), want);
+            assert_eq!(fresh.slot().is_some(), want);
+        }
+        if k == 0 {
+            // The coherent rays: about half blocked, and the hint mostly right.
+            assert!(
+                blocked * 3 > rays.len() && blocked * 3 < rays.len() * 2,
+                "{blocked} of {} blocked",
+                rays.len()
+            );
+            assert!(
+                repeated * 10 > blocked * 8,
+                "hint reused for {repeated} of {blocked}"
+            );
+        }
+    }
+}
+
+#[test]
+fn validate_catches_broken_wide_trees() {
+    let mut rng = Pcg32::new(8, 8);
+    let tris = random_scene(&mut rng, 500);
+    let good = Bvh::build(&tris);
+    good.validate().unwrap();
+    assert!(good.wide.len() > 10 && good.wide.len() * 2 < good.nodes.len());
+    type Breakage = (&'static str, fn(&mut Bvh));
+    let breakages: [Breakage; 7] = [
+        ("stack need understated", |b| b.stack_need -= 1),
+        ("shrunk lane box", |b| {
+            b.wide[3].max[0][0] = b.wide[3].min[0][0] - 1.0
+        }),
+        ("lane mask with a hole", |b| b.wide[0].valid = 0b101),
+        ("unused lane not zero", |b| {
+            let last = b.wide.iter().position(|n| n.valid != 0b1111).unwrap();
+            b.wide[last].child[3] = 7;
+        }),
+        ("child before its parent", |b| {
+            let (i, lane) = interior_lane(b, 1);
+            b.wide[i].child[lane] = 0;
+        }),
+        ("leaf moved", |b| {
+            let (i, lane) = leaf_lane(b);
+            b.wide[i].child[lane] += 1;
+        }),
+        ("subtree dropped", |b| {
+            let (i, lane) = interior_lane(b, 0);
+            b.wide[i].count[lane] = 1;
+        }),
+    ];
+    for (what, breakage) in breakages {
+        let mut bvh = good.clone();
+        breakage(&mut bvh);
+        assert!(bvh.validate().is_err(), "{what} not caught");
+    }
+}
+
+/// Some (node, lane) of the wide tree holding an interior child, from node `from` on.
+fn interior_lane(bvh: &Bvh, from: usize) -> (usize, usize) {
+    (from..bvh.wide.len())
+        .find_map(|i| {
+            let n = &bvh.wide[i];
+            (0..n.len()).find(|&l| n.count[l] == 0).map(|l| (i, l))
+        })
+        .unwrap()
+}
+
+/// Some (node, lane) of the wide tree holding a leaf.
+fn leaf_lane(bvh: &Bvh) -> (usize, usize) {
+    (0..bvh.wide.len())
+        .find_map(|i| {
+            let n = &bvh.wide[i];
+            (0..n.len()).find(|&l| n.count[l] > 0).map(|l| (i, l))
+        })
+        .unwrap()
+}
