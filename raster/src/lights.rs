@@ -11,7 +11,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::{Bvh, offset_origin};
+use crate::geometry::{Bvh, ShadowHint, offset_origin};
 use crate::sampling::rng::splitmix64;
 use crate::sampling::stratified_square;
 use crate::scene::Light;
@@ -34,6 +34,21 @@ pub struct Lighting<'a> {
     scale: f32,
 }
 
+/// What one thread remembers between shadow rays: the last occluder of each of the first
+/// [`ShadowHints::LIGHTS`] lights' rays, tested first by the next ray (see
+/// [`Bvh::occluded_hinted`]). Neighbouring points in a row are usually shadowed by the same
+/// triangle. A hint never changes an answer, only its cost, so images stay the same for any
+/// thread count and any order.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ShadowHints {
+    per_light: [ShadowHint; ShadowHints::LIGHTS],
+}
+
+impl ShadowHints {
+    /// Lights with a hint of their own (the rays of later lights start without one).
+    pub const LIGHTS: usize = 8;
+}
+
 /// 1 − small, so that a shadow ray stops just short of a light it aims at.
 const SHORTEN: f32 = 1.0 - 1e-4;
 
@@ -52,13 +67,13 @@ impl<'a> Lighting<'a> {
         self.occluders.is_none()
     }
 
-    fn visible(&self, p: Vec3, n: Vec3, dir: Vec3, t_max: f32) -> bool {
+    fn visible(&self, p: Vec3, n: Vec3, dir: Vec3, t_max: f32, hint: &mut ShadowHint) -> bool {
         match self.occluders {
             None => true,
             Some(bvh) => {
                 // Leave from the side the light is on.
                 let side = if n.dot(dir) >= 0.0 { n } else { -n };
-                !bvh.occluded(offset_origin(p, side, self.scale), dir, t_max)
+                !bvh.occluded_hinted(offset_origin(p, side, self.scale), dir, t_max, hint)
             }
         }
     }
@@ -66,21 +81,36 @@ impl<'a> Lighting<'a> {
     /// Total irradiance at `p` on a surface with unit normal `n`. `seed` decorrelates the
     /// area-light strata between points (deterministically).
     pub fn irradiance(&self, p: Vec3, n: Vec3, seed: u64) -> Vec3 {
+        self.irradiance_with(p, n, seed, &mut ShadowHints::default())
+    }
+
+    /// [`Lighting::irradiance`] with a thread's shadow-ray hints (same answer, faster along a
+    /// row of neighbouring points).
+    pub fn irradiance_with(&self, p: Vec3, n: Vec3, seed: u64, hints: &mut ShadowHints) -> Vec3 {
         let mut e = Vec3::ZERO;
-        self.for_each(p, n, seed, |i| e += i.irradiance);
+        self.for_each(p, n, seed, hints, |i| e += i.irradiance);
         e
     }
 
     /// Calls `f` with each light's contribution at `p` (lights that deliver nothing are
-    /// skipped).
-    pub fn for_each(&self, p: Vec3, n: Vec3, seed: u64, mut f: impl FnMut(Incident)) {
+    /// skipped); `hints` as for [`Lighting::irradiance_with`].
+    pub fn for_each(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        seed: u64,
+        hints: &mut ShadowHints,
+        mut f: impl FnMut(Incident),
+    ) {
         for (index, light) in self.lights.iter().enumerate() {
+            let mut spare = ShadowHint::NONE;
+            let hint = hints.per_light.get_mut(index).unwrap_or(&mut spare);
             let incident = match *light {
                 Light::Point {
                     position,
                     color,
                     intensity,
-                } => self.point(p, n, position, color * intensity, 1.0),
+                } => self.point(p, n, position, color * intensity, 1.0, hint),
                 Light::Spot {
                     position,
                     direction,
@@ -99,7 +129,7 @@ impl<'a> Lighting<'a> {
                     if falloff <= 0.0 {
                         continue;
                     }
-                    self.point(p, n, position, color * intensity, falloff)
+                    self.point(p, n, position, color * intensity, falloff, hint)
                 }
                 Light::Directional {
                     direction,
@@ -108,7 +138,7 @@ impl<'a> Lighting<'a> {
                 } => {
                     let dir = -direction;
                     let cos = n.dot(dir);
-                    if cos <= 0.0 || !self.visible(p, n, dir, f32::MAX) {
+                    if cos <= 0.0 || !self.visible(p, n, dir, f32::MAX, hint) {
                         continue;
                     }
                     Some(Incident {
@@ -130,6 +160,7 @@ impl<'a> Lighting<'a> {
                     color * intensity,
                     samples,
                     splitmix64(seed ^ index as u64),
+                    hint,
                 ),
             };
             if let Some(i) = incident {
@@ -145,6 +176,7 @@ impl<'a> Lighting<'a> {
         position: Vec3,
         intensity: Vec3,
         falloff: f32,
+        hint: &mut ShadowHint,
     ) -> Option<Incident> {
         let to_light = position - p;
         let d2 = to_light.length_squared();
@@ -154,7 +186,7 @@ impl<'a> Lighting<'a> {
         let d = d2.sqrt();
         let dir = to_light / d;
         let cos = n.dot(dir);
-        if cos <= 0.0 || !self.visible(p, n, dir, d * SHORTEN) {
+        if cos <= 0.0 || !self.visible(p, n, dir, d * SHORTEN, hint) {
             return None;
         }
         Some(Incident {
@@ -174,13 +206,14 @@ impl<'a> Lighting<'a> {
         intensity: Vec3,
         samples: u32,
         seed: u64,
+        hint: &mut ShadowHint,
     ) -> Option<Incident> {
         let to_center = center - p;
         let d2 = to_center.length_squared();
         let d = d2.sqrt();
         if !(d > radius) {
             // Inside the light: treat as fully lit from the centre direction.
-            return self.point(p, n, center, intensity, 1.0);
+            return self.point(p, n, center, intensity, 1.0, hint);
         }
         let axis = to_center / d;
         let sin2_max = (radius * radius / d2).min(1.0);
@@ -207,7 +240,7 @@ impl<'a> Lighting<'a> {
             // Distance to the near side of the sphere along dir.
             let along = d * cos_a;
             let t_hit = along - (radius * radius - (d2 - along * along)).max(0.0).sqrt();
-            if self.visible(p, n, dir, t_hit.max(0.0) * SHORTEN) {
+            if self.visible(p, n, dir, t_hit.max(0.0) * SHORTEN, hint) {
                 sum += cos;
             }
         }
@@ -266,6 +299,62 @@ mod tests {
         let l = Lighting::new(&lights, Some(&bvh), 2.0);
         assert_eq!(l.irradiance(Vec3::ZERO, Vec3::Z, 0), Vec3::ZERO);
         assert!(l.irradiance(Vec3::new(5.0, 0.0, 0.0), Vec3::Z, 0).x > 0.0);
+    }
+
+    #[test]
+    fn hints_carried_along_a_row_change_no_value() {
+        // Three lights (point, sphere, directional) and two occluders with edges between them:
+        // a row of points crosses lit, shadowed and half-lit stretches.
+        let lights = [
+            point_light(Vec3::new(0.0, 0.0, 3.0), 4.0),
+            Light::Sphere {
+                center: Vec3::new(1.0, 0.0, 4.0),
+                radius: 0.5,
+                color: Vec3::ONE,
+                intensity: 9.0,
+                samples: 16,
+            },
+            Light::Directional {
+                direction: Vec3::new(0.3, 0.0, -1.0).normalize(),
+                color: Vec3::ONE,
+                irradiance: 1.0,
+            },
+        ];
+        let plate = |x0: f32, x1: f32, h: f32| {
+            [
+                [
+                    Vec3::new(x0, -5.0, h),
+                    Vec3::new(x1, -5.0, h),
+                    Vec3::new(x1, 5.0, h),
+                ],
+                [
+                    Vec3::new(x0, -5.0, h),
+                    Vec3::new(x1, 5.0, h),
+                    Vec3::new(x0, 5.0, h),
+                ],
+            ]
+        };
+        let mut tris = plate(-3.0, -0.5, 1.5).to_vec();
+        tris.extend(plate(0.7, 1.5, 1.0));
+        let bvh = Bvh::build(&tris);
+        let l = Lighting::new(&lights, Some(&bvh), 5.0);
+        let mut hints = ShadowHints::default();
+        let (mut dark, mut lit) = (0, 0);
+        for i in 0..400 {
+            let p = Vec3::new(-4.0 + i as f32 * 0.02, 0.1, 0.0);
+            let seed = i as u64;
+            let with = l.irradiance_with(p, Vec3::Z, seed, &mut hints);
+            assert_eq!(with, l.irradiance(p, Vec3::Z, seed), "at {p}");
+            if with.x < 1e-3 {
+                dark += 1;
+            } else {
+                lit += 1;
+            }
+        }
+        assert!(
+            dark > 20 && lit > 20,
+            "the row crosses shadows: {dark} dark, {lit} lit"
+        );
     }
 
     #[test]

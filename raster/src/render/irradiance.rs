@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use super::RenderError;
 use super::prepare::Prepared;
-use crate::lights::Lighting;
+use crate::lights::{Lighting, ShadowHints};
 use crate::sampling::rng::splitmix64;
 use crate::sampling::{SampleTarget, poisson_samples, total_area};
 use crate::scene::SampleDensity;
@@ -109,8 +109,9 @@ pub fn light_samples(
             .par_iter()
             .zip(&set.normals)
             .enumerate()
-            .map(|(i, (&p, &n))| {
-                let e = lighting.irradiance(p, n, splitmix64((object << 40) ^ i as u64));
+            .map_init(ShadowHints::default, |hints, (i, (&p, &n))| {
+                let e =
+                    lighting.irradiance_with(p, n, splitmix64((object << 40) ^ i as u64), hints);
                 if i % 1024 == 0 {
                     progress.inc(1024);
                 }

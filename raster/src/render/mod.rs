@@ -27,7 +27,7 @@ use rayon::prelude::*;
 pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
 pub use irradiance::ObjectSamples;
 pub use prepare::{Prepared, can_occlude};
-pub use shading::{ObjectCache, PixelValue, Shading, ShadingCounters, ShadingStats};
+pub use shading::{ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounters, ShadingStats};
 
 use crate::lights::Lighting;
 use crate::material::Shader;
@@ -347,14 +347,15 @@ fn render_in_pool(
         .par_chunks_mut(w.max(1))
         .enumerate()
         .map(|(y, out)| {
-            let mut fragments = Vec::new();
+            let mut scratch = PixelScratch::default();
             let mut row = Row::default();
             for (x, slot) in out.iter_mut().enumerate() {
                 *slot = if options.collect_stats {
-                    shading.pixel(x as u32, y as u32, &mut fragments, &mut row.stats)?
+                    shading.pixel(x as u32, y as u32, &mut scratch, &mut row.stats)?
                 } else {
-                    shading.pixel(x as u32, y as u32, &mut fragments, &mut NoStats)?
+                    shading.pixel(x as u32, y as u32, &mut scratch, &mut NoStats)?
                 };
+                let fragments = &scratch.fragments;
                 row.points += fragments.len() as u64;
                 row.queries += fragments
                     .iter()

@@ -18,7 +18,7 @@ use lucent_core::{
 use super::RenderError;
 use super::prepare::Prepared;
 use crate::camera::Camera;
-use crate::lights::Lighting;
+use crate::lights::{Lighting, ShadowHints};
 use crate::material::{LocalTerm, Shader, TranslucentShader};
 use crate::raster::{Fragment, VisibilityBuffer, perspective_barycentrics};
 use crate::sampling::rng::splitmix64;
@@ -149,6 +149,15 @@ impl ShadingStats for ShadingCounters {
     }
 }
 
+/// One thread's working memory for [`Shading::pixel`].
+#[derive(Clone, Debug, Default)]
+pub struct PixelScratch {
+    /// The pixel's fragments.
+    pub fragments: Vec<Fragment>,
+    /// Shadow-ray hints, kept from pixel to pixel.
+    pub shadows: ShadowHints,
+}
+
 /// The read-only state every pixel is shaded from.
 pub struct Shading<'a> {
     /// The prepared scene.
@@ -174,15 +183,17 @@ pub struct Shading<'a> {
 }
 
 impl Shading<'_> {
-    /// Shades pixel (x, y); `fragments` is scratch space.
+    /// Shades pixel (x, y). `scratch` is one thread's working memory, best kept along a row
+    /// (its shadow-ray hints); the value does not depend on it.
     pub fn pixel<S: ShadingStats>(
         &self,
         x: u32,
         y: u32,
-        fragments: &mut Vec<Fragment>,
+        scratch: &mut PixelScratch,
         stats: &mut S,
     ) -> Result<PixelValue, RenderError> {
         let object_of = &self.prep.object_of;
+        let PixelScratch { fragments, shadows } = scratch;
         self.visibility
             .resolve(x, y, |t| object_of[t as usize], fragments);
         let mut value = PixelValue::default();
@@ -192,7 +203,7 @@ impl Shading<'_> {
         let pixel_index = y as u64 * self.camera.width as u64 + x as u64;
         for (k, fragment) in fragments.iter().enumerate() {
             let seed = splitmix64(pixel_index * 16 + k as u64);
-            let s = self.surface(fragment, seed, stats)?;
+            let s = self.surface(fragment, seed, shadows, stats)?;
             let w = fragment.coverage as f32 * per_sample;
             value.color += s.color * w;
             value.exitance += s.exitance * w;
@@ -210,16 +221,17 @@ impl Shading<'_> {
         &self,
         fragment: &Fragment,
         seed: u64,
+        shadows: &mut ShadowHints,
         stats: &mut S,
     ) -> Result<Surface, RenderError> {
         let object = fragment.key as usize;
         if S::TIMED && self.caches[object].is_some() {
             let start = Instant::now();
-            let surface = self.surface_untimed(fragment, seed, stats);
+            let surface = self.surface_untimed(fragment, seed, shadows, stats);
             stats.translucent_time(start.elapsed());
             surface
         } else {
-            self.surface_untimed(fragment, seed, stats)
+            self.surface_untimed(fragment, seed, shadows, stats)
         }
     }
 
@@ -227,6 +239,7 @@ impl Shading<'_> {
         &self,
         fragment: &Fragment,
         seed: u64,
+        shadows: &mut ShadowHints,
         stats: &mut S,
     ) -> Result<Surface, RenderError> {
         let prep = self.prep;
@@ -258,7 +271,9 @@ impl Shading<'_> {
         };
         match prep.shader_of(object) {
             Shader::Lambert { albedo } => {
-                let e = self.lighting.irradiance(position, normal, seed);
+                let e = self
+                    .lighting
+                    .irradiance_with(position, normal, seed, shadows);
                 out.irradiance = e;
                 out.color = *albedo * e * std::f32::consts::FRAC_1_PI;
             }
@@ -273,20 +288,21 @@ impl Shading<'_> {
                 let mut e = Vec3::ZERO;
                 let mut highlight = Vec3::ZERO;
                 if method.is_split() || shader.specular.is_some() || self.irradiance_everywhere {
-                    self.lighting.for_each(position, normal, seed, |incident| {
-                        e += incident.irradiance;
-                        if let Some(spec) = shader.specular {
-                            let h = (incident.direction + view).normalize_or_zero();
-                            let n_h = normal.dot(h).max(0.0);
-                            let f = fresnel::reflectance(
-                                point.profile.eta() as f64,
-                                view.dot(h).clamp(0.0, 1.0) as f64,
-                            ) as f32;
-                            let lobe = (spec.exponent + 8.0) / (8.0 * std::f32::consts::PI)
-                                * n_h.powf(spec.exponent);
-                            highlight += incident.irradiance * (spec.strength * f * lobe);
-                        }
-                    });
+                    self.lighting
+                        .for_each(position, normal, seed, shadows, |incident| {
+                            e += incident.irradiance;
+                            if let Some(spec) = shader.specular {
+                                let h = (incident.direction + view).normalize_or_zero();
+                                let n_h = normal.dot(h).max(0.0);
+                                let f = fresnel::reflectance(
+                                    point.profile.eta() as f64,
+                                    view.dot(h).clamp(0.0, 1.0) as f64,
+                                ) as f32;
+                                let lobe = (spec.exponent + 8.0) / (8.0 * std::f32::consts::PI)
+                                    * n_h.powf(spec.exponent);
+                                highlight += incident.irradiance * (spec.strength * f * lobe);
+                            }
+                        });
                 }
                 let k = match &oc.local {
                     Some(_) if self.exact_local_integral => {
