@@ -62,6 +62,12 @@ impl<'a> Lighting<'a> {
         }
     }
 
+    /// The same lights with other occluders (e.g. without the triangles of the object the
+    /// rays leave, when it cannot shadow itself).
+    pub fn with_occluders(self, occluders: Option<&'a Bvh>) -> Self {
+        Lighting { occluders, ..self }
+    }
+
     /// True if nothing can cast shadows (no shadow rays are traced).
     pub fn unshadowed(&self) -> bool {
         self.occluders.is_none()

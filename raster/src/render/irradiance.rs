@@ -97,12 +97,15 @@ pub fn place_samples(
 }
 
 /// Irradiance at every sample (in parallel; each sample's value depends only on its index).
+/// Shadow rays use each object's own occluders ([`Prepared::occluders_for`]).
 pub fn light_samples(
+    prep: &Prepared,
     sets: &mut [ObjectSamples],
     lighting: &Lighting,
     progress: &indicatif::ProgressBar,
 ) {
     for set in sets.iter_mut() {
+        let lighting = lighting.with_occluders(prep.occluders_for(set.object));
         let object = set.object as u64;
         set.irradiance = set
             .positions

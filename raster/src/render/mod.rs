@@ -12,6 +12,7 @@
 //! for any thread count.
 
 mod baked;
+mod convexity;
 mod irradiance;
 mod prepare;
 mod shading;
@@ -208,7 +209,7 @@ pub fn bake(scene: &Scene, progress: bool) -> Result<Vec<ObjectSamples>, RenderE
         let mut sets = irradiance::place_samples(&prep, scene.render.samples, scene.render.seed)?;
         let total: usize = sets.iter().map(|s| s.len()).sum();
         let b = bar(progress, total as u64, "irradiance");
-        irradiance::light_samples(&mut sets, &lighting, &b);
+        irradiance::light_samples(&prep, &mut sets, &lighting, &b);
         b.finish_and_clear();
         Ok(sets)
     })
@@ -249,7 +250,7 @@ fn render_in_pool(
             let t = Instant::now();
             let total: usize = sets.iter().map(|s| s.len()).sum();
             let b = bar(options.progress, total as u64, "irradiance");
-            irradiance::light_samples(&mut sets, &lighting, &b);
+            irradiance::light_samples(&prep, &mut sets, &lighting, &b);
             b.finish_and_clear();
             timings.irradiance = t.elapsed();
             sets

@@ -269,11 +269,10 @@ impl Shading<'_> {
             position,
             ..Surface::default()
         };
+        let lighting = self.lighting.with_occluders(prep.occluders_for(object));
         match prep.shader_of(object) {
             Shader::Lambert { albedo } => {
-                let e = self
-                    .lighting
-                    .irradiance_with(position, normal, seed, shadows);
+                let e = lighting.irradiance_with(position, normal, seed, shadows);
                 out.irradiance = e;
                 out.color = *albedo * e * std::f32::consts::FRAC_1_PI;
             }
@@ -288,21 +287,20 @@ impl Shading<'_> {
                 let mut e = Vec3::ZERO;
                 let mut highlight = Vec3::ZERO;
                 if method.is_split() || shader.specular.is_some() || self.irradiance_everywhere {
-                    self.lighting
-                        .for_each(position, normal, seed, shadows, |incident| {
-                            e += incident.irradiance;
-                            if let Some(spec) = shader.specular {
-                                let h = (incident.direction + view).normalize_or_zero();
-                                let n_h = normal.dot(h).max(0.0);
-                                let f = fresnel::reflectance(
-                                    point.profile.eta() as f64,
-                                    view.dot(h).clamp(0.0, 1.0) as f64,
-                                ) as f32;
-                                let lobe = (spec.exponent + 8.0) / (8.0 * std::f32::consts::PI)
-                                    * n_h.powf(spec.exponent);
-                                highlight += incident.irradiance * (spec.strength * f * lobe);
-                            }
-                        });
+                    lighting.for_each(position, normal, seed, shadows, |incident| {
+                        e += incident.irradiance;
+                        if let Some(spec) = shader.specular {
+                            let h = (incident.direction + view).normalize_or_zero();
+                            let n_h = normal.dot(h).max(0.0);
+                            let f = fresnel::reflectance(
+                                point.profile.eta() as f64,
+                                view.dot(h).clamp(0.0, 1.0) as f64,
+                            ) as f32;
+                            let lobe = (spec.exponent + 8.0) / (8.0 * std::f32::consts::PI)
+                                * n_h.powf(spec.exponent);
+                            highlight += incident.irradiance * (spec.strength * f * lobe);
+                        }
+                    });
                 }
                 let k = match &oc.local {
                     Some(_) if self.exact_local_integral => {
