@@ -107,6 +107,7 @@ fn quick_bench_writes_a_complete_report() {
         "### 1. Edge-aware overhead",
         "### 2. Shadow edges",
         "for several smoothing radii",
+        "Where the error comes from",
         "### 3. Texture-mapped",
         "### 4. Speed",
     ] {

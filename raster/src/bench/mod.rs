@@ -31,6 +31,7 @@ mod figures;
 mod report;
 mod runner;
 mod scenes;
+mod split;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -39,6 +40,7 @@ use std::time::{Duration, Instant};
 pub use report::{write_csv, write_markdown};
 pub use runner::{MethodSetting, Reference, RunResult};
 pub use scenes::BenchScene;
+pub use split::TermErrors;
 
 use crate::output::{ErrorStats, OutputError, RgbImage, compare, write_exr, write_png};
 use crate::plot::PlotError;
@@ -269,6 +271,22 @@ pub struct SmoothingRow {
     pub edge_aware: RunResult,
 }
 
+/// Local-global's and edge-aware's errors at the sheet count split into the global and the
+/// local term (see the `split` module), per region.
+#[derive(Clone, Debug)]
+pub struct ErrorSplit {
+    /// The scene.
+    pub scene: BenchScene,
+    /// Samples of the split runs.
+    pub samples: usize,
+    /// The smoothing factor the truth was re-rendered with to match their α.
+    pub truth_smoothing: f32,
+    /// Shadow-edge band: local-global, edge-aware.
+    pub band: [TermErrors; 2],
+    /// Translucent pixels: local-global, edge-aware.
+    pub translucent: [TermErrors; 2],
+}
+
 /// The K table against exact K per pixel (textured scene, edge-aware).
 #[derive(Clone, Debug)]
 pub struct TableCheck {
@@ -297,6 +315,8 @@ pub struct BenchReport {
     pub exhaustive: Vec<ExhaustiveRow>,
     /// Local-global and edge-aware at several smoothing factors, per scene.
     pub smoothing: Vec<SmoothingRow>,
+    /// Their errors split into the two terms, per scene.
+    pub splits: Vec<ErrorSplit>,
     /// The textured scene's table check.
     pub table: Option<TableCheck>,
     /// The default scene end to end (render + PNG + EXR).
@@ -324,6 +344,7 @@ pub fn run(
         runs: Vec::new(),
         exhaustive: Vec::new(),
         smoothing: Vec::new(),
+        splits: Vec::new(),
         table: None,
         end_to_end: None,
         threads: 0,
@@ -391,6 +412,7 @@ fn run_scene(
     });
 
     let mut sheet_images = Vec::new();
+    let mut split_runs = Vec::new();
     for &count in &config.counts {
         for setting in config.settings() {
             let (result, first) =
@@ -406,14 +428,38 @@ fn run_scene(
             ));
             report.threads = result.threads;
             if count == config.sheet_count {
+                if setting.method != SssMethod::Hierarchical {
+                    split_runs.push((first.stats.samples, first.pixels));
+                }
                 sheet_images.push((setting, first.image));
             }
             report.runs.push(result);
         }
     }
-    report.smoothing.extend(smoothing_sweep(
-        config, scene, &base, report, &reference, log,
-    )?);
+    let sweep = smoothing_sweep(config, scene, &base, report, &reference, log)?;
+    report.smoothing.extend(sweep);
+    if let [(samples, lm), (_, n10)] = &split_runs[..] {
+        let mut matched = truth_scene.clone();
+        matched.render.smoothing =
+            split::matched_smoothing(base.render.smoothing, reference.samples, *samples);
+        log(&format!(
+            "{name}: the truth again at k = {} (the α of {samples} samples), for the error split",
+            matched.render.smoothing
+        ));
+        let exact =
+            runner::render_once(&runner::configure(&matched, truth_setting, n, 1000), false)?;
+        let exact_global: Vec<glam::Vec3> = exact.pixels.iter().map(|p| p.global).collect();
+        let errors = |mask: &[bool]| {
+            [lm, n10].map(|run| split::term_errors(&reference.exitance, &exact_global, run, mask))
+        };
+        report.splits.push(ErrorSplit {
+            scene,
+            samples: *samples,
+            truth_smoothing: matched.render.smoothing,
+            band: errors(&reference.band),
+            translucent: errors(&reference.translucent),
+        });
+    }
     figures::write_scene_figures(
         config,
         scene,

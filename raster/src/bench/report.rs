@@ -118,6 +118,37 @@ fn smoothing_sweep(report: &BenchReport, s: &mut String) {
     }
 }
 
+/// Claim 2's errors divided into the global and the local term.
+fn error_split(report: &BenchReport, s: &mut String) {
+    if report.splits.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "\nWhere the error comes from, at the scene's k: each split run's error against the truth divided into its global and its local term, the truth split at the runs' own α (re-rendered at the matched k; `raster/src/bench/split.rs`). Shares of the truth's exitance, Σ|error| / Σ|truth| (not the offset-relative error above).\n\n| scene | samples | region | global term: local-global | edge-aware | local term: local-global | edge-aware | local ratio | total: local-global | edge-aware |\n|---|---:|---|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for split in &report.splits {
+        for (region, [l, e]) in [
+            ("edge band", split.band),
+            ("translucent", split.translucent),
+        ] {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {region} | {} | {} | {} | {} | {:.2} | {} | {} |",
+                split.scene.name(),
+                split.samples,
+                pct(l.global),
+                pct(e.global),
+                pct(l.local),
+                pct(e.local),
+                e.local / l.local,
+                pct(l.total),
+                pct(e.total),
+            );
+        }
+    }
+}
+
 /// The claims, as Markdown lines with verdicts.
 fn claims(report: &BenchReport) -> String {
     let c = &report.config;
@@ -210,6 +241,7 @@ fn claims(report: &BenchReport) -> String {
     }
 
     smoothing_sweep(report, &mut s);
+    error_split(report, &mut s);
 
     let _ = writeln!(s, "\n### 3. Texture-mapped ℓ_u: the power-of-two K table\n");
     match &report.table {

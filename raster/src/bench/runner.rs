@@ -1,10 +1,11 @@
 //! Running one benchmark configuration: render it once per seed, take the median time per
 //! phase, and measure every error metric against the ground truth.
 //!
-//! Times are wall clock per phase ([`Timings`]) as the renderer reports them; "CPU per
-//! lookup" is the shading phase's wall time × threads / translucent lookups, which charges
-//! rasterisation resolve, shadow rays for E(x) and radiance to the lookups (an upper bound on
-//! the query itself).
+//! Times are wall clock per phase ([`Timings`]) as the renderer reports them. "CPU per
+//! lookup" is the time of the translucent shading points (attributes, material, E(x) where the
+//! method needs it, the query, the radiance) summed over threads, per lookup; the whole
+//! shading phase per lookup, which also charges the opaque pixels to the lookups, is kept
+//! beside it.
 
 use std::time::Duration;
 
@@ -45,6 +46,8 @@ impl MethodSetting {
 pub struct Reference {
     /// The reference image.
     pub image: RgbImage,
+    /// Its exitance per pixel.
+    pub exitance: Vec<Vec3>,
     /// Translucent pixels (from its exitance).
     pub translucent: Vec<bool>,
     /// The shadow-edge band (from its irradiance); may select no pixel.
@@ -76,6 +79,7 @@ impl Reference {
         )?;
         Ok(Reference {
             image: r.image,
+            exitance,
             translucent,
             band,
             samples: r.stats.samples,
