@@ -36,7 +36,7 @@ fn scene() -> Vec<[Vec3; 3]> {
 }
 
 /// Shadow rays from random surface points (offset along the face normal, towards the light) to
-/// a point light: about a quarter are blocked.
+/// a point light: about half are blocked (52.8% of this set).
 fn shadow_rays(tris: &[[Vec3; 3]], bvh: &Bvh, n: usize) -> Vec<(Vec3, Vec3)> {
     let light = Vec3::new(2.0, -1.5, 5.0);
     let mut rng = Pcg32::new(1, 0);

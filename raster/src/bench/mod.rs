@@ -493,9 +493,9 @@ fn run_scene(
 /// (claim 2). At the scene's own k the main runs are reused.
 ///
 /// Why a sweep: at k = 1.5 the two differ little in the shadow-edge band, because most of the
-/// band's error there is the global sum's, which both share (on the sphere at 23k, measured
-/// by splitting the truth at the same α: 2.2% of the band error is the global term's, the
-/// local term adds 1.7% for local-global and 0.8% for edge-aware). A larger α moves work from
+/// band's error there is the global sum's, which both share (the `split` step: on the
+/// sphere at 23k the global term errs by 2.1% of the band's exitance, the local term by 1.6%
+/// for local-global and 0.8% for edge-aware). A larger α moves work from
 /// the noisy global sum to the local term: local-global's edge then hardens (N10's Figure 1
 /// and the reference sheet §5), edge-aware's does not.
 fn smoothing_sweep(
