@@ -356,14 +356,15 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         }
     }
 
-    /// Pops and examines nodes until the stack is empty. `defer`: N10 may set unlit subtrees
-    /// near x aside instead of opening them.
-    fn descend(
+    /// Pops and examines nodes until the stack is empty. `DEFER`: N10 may set unlit subtrees
+    /// near x aside instead of opening them (a constant: each pass is compiled on its own, and
+    /// the renderer's shading ran 7% fewer instructions than with a run-time flag, by
+    /// callgrind; divan saw no difference in time).
+    fn descend<const DEFER: bool>(
         &mut self,
         params: &Params,
         stack: &mut [u32; STACK_SIZE],
         mut sp: usize,
-        defer: bool,
     ) {
         let nodes = &self.cache.nodes;
         let zero = L::splat(0.0);
@@ -413,7 +414,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
             let mut live = valid & lit;
             if MODE == EDGE_AWARE {
                 let unlit_near = valid & near & !lit;
-                if defer {
+                if DEFER {
                     let mut bits = unlit_near.0;
                     while bits != 0 {
                         let lane = bits.trailing_zeros() as usize;
@@ -517,7 +518,11 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
             self.leaf(0, true);
         } else {
             stack[0] = 0;
-            self.descend(params, &mut stack, 1, MODE == EDGE_AWARE);
+            if MODE == EDGE_AWARE {
+                self.descend::<true>(params, &mut stack, 1);
+            } else {
+                self.descend::<false>(params, &mut stack, 1);
+            }
         }
         self.flush_samples();
         if MODE == EDGE_AWARE && self.deferred_len > 0 {
@@ -530,7 +535,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                 for &node in &deferred[..self.deferred_len] {
                     self.open(node as usize, true, &mut stack, &mut sp);
                 }
-                self.descend(params, &mut stack, sp, false);
+                self.descend::<false>(params, &mut stack, sp);
                 self.flush_samples();
             }
         }
