@@ -26,6 +26,7 @@ use lucent_core::{IrradianceCache, Method, NoStats, QuerySettings, QueryStats};
 use rayon::prelude::*;
 
 pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
+pub use convexity::cannot_shadow_itself;
 pub use irradiance::ObjectSamples;
 pub use prepare::{Prepared, can_occlude};
 pub use shading::{ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounters, ShadingStats};
