@@ -116,7 +116,7 @@ pub struct BenchConfig {
 }
 
 impl BenchConfig {
-    /// The full experiment (about 15 minutes on two cores).
+    /// The full experiment (about 5 minutes on two cores).
     pub fn full() -> Self {
         BenchConfig {
             resolution: 512,
