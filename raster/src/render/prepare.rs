@@ -170,4 +170,52 @@ mod tests {
             crate::scene::obj::parse_obj(include_bytes!("../../../assets/bunny.obj")).unwrap();
         assert!(can_occlude(&[object(bunny)]));
     }
+
+    fn scene(objects: &str) -> Scene {
+        let text = format!(
+            "[camera]\nposition = [0.0, -6.0, 2.0]\ntarget = [0.0, 0.0, 1.0]\nfov = 30.0\n{objects}\n\
+             [material.m]\ntype = \"lambert\"\nalbedo = 0.5\n\
+             [[light]]\ntype = \"point\"\nposition = [0.0, 0.0, 5.0]\nintensity = 1.0\n"
+        );
+        crate::scene::parse_scene(
+            &text,
+            &crate::scene::SceneOrigin::Embedded {
+                name: "test.toml".into(),
+                files: Vec::new(),
+            },
+        )
+        .unwrap()
+    }
+
+    const SPHERE: &str =
+        "[[object]]\nshape = \"sphere\"\nradius = 1.0\nsegments = 32\nmaterial = \"m\"\n";
+    const BOX: &str = "[[object]]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\ntranslate = [3.0, 0.0, 0.0]\nmaterial = \"m\"\n";
+    const PLANE: &str = "[[object]]\nshape = \"plane\"\nsize = [9.0, 9.0]\ntranslate = [0.0, 0.0, -1.0]\nmaterial = \"m\"\n";
+
+    #[test]
+    fn large_objects_that_cannot_shadow_themselves_get_the_other_objects_bvh() {
+        let s = scene(&format!("{SPHERE}{BOX}{PLANE}"));
+        let prep = Prepared::new(&s).unwrap();
+        let all = prep
+            .occluders
+            .as_ref()
+            .expect("three objects can occlude")
+            .len();
+        let own = |o: usize| (prep.first_triangle[o + 1] - prep.first_triangle[o]) as usize;
+        // The sphere holds most triangles: its rays see only the box and the plane.
+        assert!(own(0) * 4 >= all);
+        assert_eq!(prep.occluders_for(0).map(Bvh::len), Some(all - own(0)));
+        // The box and the plane are convex and flat but small: the scene's BVH.
+        for o in [1, 2] {
+            assert!(prep.others[o].is_none());
+            assert_eq!(prep.occluders_for(o).map(Bvh::len), Some(all));
+        }
+        // Alone, the sphere casts no shadow at all; with only a plane beside it, the plane's
+        // rays use everything and the sphere's only the plane.
+        let alone = scene(SPHERE);
+        assert!(Prepared::new(&alone).unwrap().occluders_for(0).is_none());
+        let two = scene(&format!("{SPHERE}{PLANE}"));
+        let prep = Prepared::new(&two).unwrap();
+        assert_eq!(prep.occluders_for(0).map(Bvh::len), Some(2));
+    }
 }
