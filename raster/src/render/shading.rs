@@ -203,7 +203,12 @@ impl Shading<'_> {
         let pixel_index = y as u64 * self.camera.width as u64 + x as u64;
         for (k, fragment) in fragments.iter().enumerate() {
             let seed = splitmix64(pixel_index * 16 + k as u64);
+            let timed = S::TIMED && self.caches[fragment.key as usize].is_some();
+            let start = timed.then(Instant::now);
             let s = self.surface(fragment, seed, shadows, stats)?;
+            if let Some(start) = start {
+                stats.translucent_time(start.elapsed());
+            }
             let w = fragment.coverage as f32 * per_sample;
             value.color += s.color * w;
             value.exitance += s.exitance * w;
@@ -218,24 +223,6 @@ impl Shading<'_> {
     }
 
     fn surface<S: ShadingStats>(
-        &self,
-        fragment: &Fragment,
-        seed: u64,
-        shadows: &mut ShadowHints,
-        stats: &mut S,
-    ) -> Result<Surface, RenderError> {
-        let object = fragment.key as usize;
-        if S::TIMED && self.caches[object].is_some() {
-            let start = Instant::now();
-            let surface = self.surface_untimed(fragment, seed, shadows, stats);
-            stats.translucent_time(start.elapsed());
-            surface
-        } else {
-            self.surface_untimed(fragment, seed, shadows, stats)
-        }
-    }
-
-    fn surface_untimed<S: ShadingStats>(
         &self,
         fragment: &Fragment,
         seed: u64,
