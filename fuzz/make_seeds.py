@@ -319,9 +319,124 @@ def raster_seeds():
     write(t, "tall-grid", bytes([0, 8 | (3 << 4)]) + exact(0, [(0, 0, 0), (1024, 4096 * 4 * 256, 5000), (0, 4096 * 4 * 128, 65535)]))
 
 
+# ------------------------------------------------------------------- shadow_rays_match_brute_force
+def shadow_seeds():
+    t = "shadow_rays_match_brute_force"
+
+    def g(v):
+        """A grid byte for the integer v in [-4, 4] (coordinate (b mod 9) - 4)."""
+        return (v + 4) % 9
+
+    def h(v2):
+        """An origin byte for the half-integer v2/2, v2 in [-8, 8]."""
+        return (v2 + 8) % 17
+
+    # Mode 0: a closed octahedron around the origin (unit vertices), and a flat fan with shared
+    # edges in z = 0; rays straight at its vertices and edges, along edges, with every t code.
+    octa = []
+    px, nx, py, ny, pz, nz = (1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)
+    for a, b in ((px, py), (py, nx), (nx, ny), (ny, px)):
+        octa += [(a, b, pz), (b, a, nz)]
+    fan = [((0, 0, 2), (2, 0, 2), (0, 2, 2)), ((0, 0, 2), (0, 2, 2), (-2, 0, 2)),
+           ((0, 0, 2), (-2, 0, 2), (0, -2, 2)), ((0, 0, 2), (0, -2, 2), (2, 0, 2))]
+    tris = octa + fan
+    out = bytearray([0, len(tris)])
+    for tri in tris:
+        out += bytes(g(c) for v in tri for c in v)
+    rays = [((0, 0, 8), (0, 0, -1), 0), ((0, 0, 8), (0, 0, -1), 1), ((0, 0, 8), (0, 0, -1), 2),
+            ((0, 0, 8), (0, 0, -1), 3), ((0, 0, 8), (0, 0, -1), 4), ((0, 0, 8), (0, 0, -1), 5),
+            ((2, 0, 8), (0, 0, -1), 0), ((1, 1, 8), (0, 0, -1), 0), ((2, 2, 8), (0, 0, -1), 0),
+            ((-8, 0, 0), (1, 0, 0), 0), ((-8, 0, 4), (1, 0, 0), 0), ((0, 0, 8), (0, 0, -1), 6 + 16 * 2),
+            ((0, 0, 8), (0, 0, -1), 6 + 16 * 3), ((0, 0, 8), (0, 0, -1), 6 + 16 * 4), ((4, 4, 4), (-1, -1, -1), 0),
+            ((0, 0, 0), (1, 1, 1), 0), ((0, 0, 0), (0, 0, 0), 0), ((1, 0, 8), (0, 1, -4), 0)]
+    for o, d, tc in rays:
+        out += bytes(h(c) for c in o) + bytes(g(c) for c in d) + bytes([tc])
+    write(t, "grid-octahedron-fan", out)
+    # Mode 1: triangles at scales 2^-120 … 2^120 (one around the origin at each), rays at
+    # matching and mismatched scales.
+    out = bytearray([1, 12])
+    for k, e in enumerate(range(-120, 121, 22)):
+        out += i8(e) + b"".join(i8(c) for c in (-100, -100, k, 100, -100, k, 0, 100, -k))
+    for e in range(-120, 121, 20):
+        out += i8(e) + i8(3) + i8(-5) + i8(100) + i8(-e // 2) + i8(0) + i8(0) + i8(-1) + bytes([0])
+    write(t, "scaled-magnitudes", out)
+    # Mode 2: raw bits: NaN and infinite vertices (skipped), huge and subnormal ones, and rays
+    # with NaN / infinite parts and t_max.
+    nan, inf = float("nan"), float("inf")
+    tris = [((0, 0, 1), (1, 0, 1), (0, 1, 1)), ((nan, 0, 1), (1, 0, 1), (0, 1, 1)),
+            ((3e38, -3e38, 0), (-3e38, -3e38, 0), (0, 3e38, 0)), ((inf, 0, 0), (0, 0, 0), (0, 1, 0)),
+            ((1e-45, 0, 2), (0, 1e-45, 2), (-1e-45, -1e-45, 2)), ((0, 0, 3), (1e-38, 0, 3), (0, 1e-38, 3))]
+    out = bytearray([2, len(tris)])
+    for tri in tris:
+        out += b"".join(f32(c) for v in tri for c in v)
+    for o, d, tm in (((0.25, 0.25, 5), (0, 0, -1), inf), ((0.25, 0.25, 5), (0, 0, -1), 4.5),
+                     ((0, 0, 5), (0, 0, -1), nan), ((nan, 0, 5), (0, 0, -1), inf),
+                     ((0, 0, 5), (0, 0, -inf), inf), ((0, 0, 5), (1e-40, 0, -1e-30), inf),
+                     ((0, 0, -5), (0, 0, 3e38), 1.0), ((0, 0, 5), (0, 0, -1), -0.0)):
+        out += b"".join(f32(c) for c in o + d) + f32(tm)
+    write(t, "raw-nan-inf-huge", out)
+    # Mode 3: the coherent scene: sphere (80), box of 2 divisions, 8 × 8 plate; a light above
+    # and to the side; 64 rays from the plate in scanline order, then rays from the objects.
+    light = bytes([i8(-20)[0], i8(8)[0], 40])
+    write(t, "coherent-plate-scanline", bytes([3, 1 | (2 << 1) | (7 << 3)]) + light + i8(0) + bytes((k * 37) % 128 for k in range(64)))
+    write(t, "coherent-objects", bytes([3, 0 | (1 << 1) | (3 << 3)]) + light + i8(0) + bytes(128 | k for k in range(64)))
+    write(t, "coherent-huge-scale", bytes([3, 1 | (3 << 1) | (2 << 3)]) + light + i8(20) + bytes((128 if k % 3 else 0) | k for k in range(64)))
+    write(t, "coherent-tiny-scale", bytes([3, 1 | (1 << 3)]) + bytes([0, 0, 0]) + i8(-23) + bytes(k % 256 for k in range(0, 256, 4)))
+
+
+# ------------------------------------------------------------------------------ convexity_is_sound
+def convexity_seeds():
+    t = "convexity_is_sound"
+
+    def arbitrary(verts, tris, scale=0, raw=False, transform=b"\x00"):
+        out = bytearray([0, len(verts) - 3, 1 if raw else 0])
+        if not raw:
+            out += i8(scale)
+        for v in verts:
+            out += b"".join(f32(c) if raw else i8(c) for c in v)
+        return out + bytes([len(tris)]) + bytes(i for tr in tris for i in tr) + transform
+
+    def shape(kind, sizes=b"", perturb=(), edits=(), transform=b"\x00"):
+        out = bytearray([1, kind]) + sizes + bytes([len(perturb)])
+        for v, e, a, c in perturb:
+            out += u16(v) + bytes([e]) + i8(a) + i8(c)
+        out += bytes([len(edits)])
+        for k, flip in edits:
+            out += u16(k) + bytes([1 if flip else 0])
+        return out + transform
+
+    tetra = [(0, 0, 0), (10, 0, 0), (0, 10, 0), (0, 0, 10)]
+    tetra_faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    write(t, "tetrahedron", arbitrary(tetra, tetra_faces))
+    write(t, "tetrahedron-one-face-flipped", arbitrary(tetra, tetra_faces[:3] + [(1, 3, 2)]))
+    write(t, "two-tetrahedra-sharing-a-vertex", arbitrary(tetra + [(-10, 0, 0), (0, -10, 0), (0, 0, -10)],
+          tetra_faces + [(0, 4, 5), (0, 6, 4), (0, 5, 6), (4, 6, 5)]))
+    write(t, "flat-fan", arbitrary([(0, 0, 0), (5, 0, 0), (5, 5, 0), (0, 5, 0), (-5, 3, 0)], [(0, 1, 2), (0, 2, 3), (0, 3, 4)], scale=-3))
+    write(t, "raw-huge-coordinates", arbitrary([(3e38, 0, 0), (-3e38, 0, 0), (0, 3e38, 0), (0, 0, 3e38), (0, 0, -3e38)],
+          [(0, 2, 3), (2, 1, 3), (1, 0, 4), (0, 1, 2)], raw=True))
+    # Sphere (16 segments): intact, one vertex pushed out, one pushed in, a face removed.
+    s16 = 1 + 3 * 4
+    write(t, "sphere-intact-rotated", shape(s16, transform=bytes([1, 20, 200, 90])))
+    write(t, "sphere-vertex-out", shape(s16, perturb=[(40, 3, 1, 0)]))
+    write(t, "sphere-vertex-in-slightly", shape(s16, perturb=[(40, 16, -3, 0)]))
+    write(t, "sphere-face-removed", shape(s16, edits=[(10, False)]))
+    write(t, "sphere-face-flipped", shape(s16, edits=[(10, True)]))
+    # Cuboid: a corner pushed in, a corner lifted by a hair, a face removed; scaled and moved.
+    box = bytes([15, 31, 63])
+    write(t, "cuboid-corner-in", shape(1, box, perturb=[(0, 2, -1, 0)]))
+    write(t, "cuboid-corner-hair-out", shape(1, box, perturb=[(2, 20, 0, 3)]))
+    write(t, "cuboid-face-removed-moved", shape(1, box, edits=[(4, False), (4, False)],
+          transform=bytes([7, 10, 20, 30, 0x80, 0x7f, 0x10, 5, 100])))
+    write(t, "cuboid-tiny-scale", shape(1, box, transform=bytes([4, 0xC1])))
+    # Plane: lifted corner (not flat), tilted.
+    write(t, "plane-corner-lifted", shape(2, bytes([15, 31]), perturb=[(1, 4, 0, 5)], transform=bytes([1, 7, 8, 9])))
+
+
 if __name__ == "__main__":
     cache_seeds()
     table_seeds()
     scene_seeds()
     obj_seeds()
     raster_seeds()
+    shadow_seeds()
+    convexity_seeds()

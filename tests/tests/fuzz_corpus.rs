@@ -71,6 +71,16 @@ fn raster_triangle_in_bounds() {
     replay("raster_triangle_in_bounds");
 }
 
+#[test]
+fn shadow_rays_match_brute_force() {
+    replay("shadow_rays_match_brute_force");
+}
+
+#[test]
+fn convexity_is_sound() {
+    replay("convexity_is_sound");
+}
+
 /// Every fuzz target has a property and a corpus, and every corpus a target: a target added
 /// without its replay (or a misspelt directory) fails here.
 #[test]

@@ -88,13 +88,20 @@ impl Aabb {
 const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// Direction components smaller than this in magnitude are replaced by ±`TINY_DIR` before
-/// taking the reciprocal, so the slab test never multiplies `0 · ∞` (which would give NaN for a
-/// ray starting exactly on a slab plane). The change moves the ray by `TINY_DIR · t`, far below
-/// one ulp of any coordinate a scene can use. The one case it does not treat as the exact
-/// direction would: a ray lying *in the plane* of a box of zero thickness gets the entry interval
-/// `[0, 0]` on that axis and is rejected. That box holds only triangles coplanar with the ray,
-/// which the triangle test cannot hit anyway.
+/// taking the reciprocal, so the reciprocal is finite and the slab test never multiplies
+/// `0 · ∞`. The slab test treats such an axis as *parallel*: the ray is inside that slab for
+/// every `t` when its origin lies in `[min, max]` (boundary included) and for none otherwise,
+/// with no arithmetic. (Computing the slab with the replaced component instead moved the ray
+/// off a boundary plane it lies in: a ray with `dir.y = 0` in the plane `y = max.y` of a box
+/// left it at `t = 0`, and a ray through the shared edge of two axis-aligned triangles saw only
+/// one of them. Found by the fuzz target `shadow_rays_match_brute_force`,
+/// `crash-axis-parallel-ray-on-box-face`.) For a non-zero component below `TINY_DIR` this
+/// ignores the ray's drift along the axis, which matters only at distances `t` beyond
+/// `δ / TINY_DIR` for a slab `δ` away.
 const TINY_DIR: f32 = 1e-30;
+
+/// `|inv_dir|` from [`safe_inverse`] at or above which an axis is parallel (see [`TINY_DIR`]).
+const PARALLEL_INV: f32 = 1.0 / TINY_DIR;
 
 /// The reciprocal direction used by [`slab_test`], finite in every component.
 pub(crate) fn safe_inverse(dir: Vec3) -> Vec3A {
@@ -123,8 +130,20 @@ pub(crate) fn slab_test(
 ) -> Option<f32> {
     let t0 = (min - origin) * inv_dir;
     let t1 = (max - origin) * inv_dir;
-    let near = t0.min(t1).max_element().max(0.0);
-    let far = (t0.max(t1).min_element() * ROBUST_FAR).min(t_max);
+    let (mut near, mut far) = (t0.min(t1), t0.max(t1));
+    for a in 0..3 {
+        if inv_dir[a].abs() >= PARALLEL_INV {
+            let inside = min[a] <= origin[a] && origin[a] <= max[a];
+            near[a] = if inside {
+                f32::NEG_INFINITY
+            } else {
+                f32::INFINITY
+            };
+            far[a] = f32::INFINITY;
+        }
+    }
+    let near = near.max_element().max(0.0);
+    let far = (far.min_element() * ROBUST_FAR).min(t_max);
     (near <= far).then_some(near)
 }
 
@@ -134,6 +153,8 @@ pub(crate) fn slab_test(
 pub(crate) struct RayLanes {
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
+    /// Axes the ray is parallel to (see [`TINY_DIR`]).
+    parallel: [bool; 3],
 }
 
 impl RayLanes {
@@ -142,6 +163,7 @@ impl RayLanes {
         RayLanes {
             origin: [0, 1, 2].map(|a| Vec4::splat(origin[a])),
             inv_dir: [0, 1, 2].map(|a| Vec4::splat(inv_dir[a])),
+            parallel: [0, 1, 2].map(|a| inv_dir[a].abs() >= PARALLEL_INV),
         }
     }
 
@@ -154,8 +176,15 @@ impl RayLanes {
     #[inline(always)]
     pub(crate) fn slab_test(&self, node: &WideNode, t_max: Vec4) -> (u32, Vec4) {
         let slab = |a: usize| {
-            let t0 = (Vec4::from_array(node.min[a]) - self.origin[a]) * self.inv_dir[a];
-            let t1 = (Vec4::from_array(node.max[a]) - self.origin[a]) * self.inv_dir[a];
+            let (lo, hi) = (Vec4::from_array(node.min[a]), Vec4::from_array(node.max[a]));
+            if self.parallel[a] {
+                // Inside the slab for every t, or for none (see `TINY_DIR`).
+                let inside = lo.cmple(self.origin[a]) & self.origin[a].cmple(hi);
+                let near = Vec4::select(inside, Vec4::NEG_INFINITY, Vec4::INFINITY);
+                return (near, Vec4::INFINITY);
+            }
+            let t0 = (lo - self.origin[a]) * self.inv_dir[a];
+            let t1 = (hi - self.origin[a]) * self.inv_dir[a];
             (t0.min(t1), t0.max(t1))
         };
         let (nx, fx) = slab(0);
@@ -257,6 +286,30 @@ mod tests {
             }
         }
         assert!(accepted > 5_000, "only {accepted} boxes hit");
+    }
+
+    /// `crash-axis-parallel-ray-on-box-face`: a ray with `dir.y = 0` lying in the plane of a
+    /// box's face (`o.y = max.y` or `min.y`) passes through the box's boundary at every `t`; it
+    /// used to be moved off that plane by the replaced component and rejected past `t = 0`.
+    #[test]
+    fn a_parallel_ray_in_a_box_face_plane_is_accepted() {
+        let (min, max) = (Vec3::new(0.0, -0.25, 0.0), Vec3::new(1.0, 0.5, 1.0));
+        let d = Vec3::new(-2.9, 0.0, 4.5);
+        for y in [0.5, -0.25] {
+            let o = Vec3::new(1.7, y, -1.0);
+            assert!(slab(min, max, o, safe_inverse(d), 1.0).is_some(), "y = {y}");
+            let mut node = WideNode::EMPTY;
+            node.set_lane(0, &Aabb { min, max }, 0, 1);
+            let (mask, _) =
+                RayLanes::new(o.into(), safe_inverse(d)).slab_test(&node, Vec4::splat(1.0));
+            assert_eq!(mask, 1, "y = {y}");
+        }
+        // Just outside the slab: rejected; a tiny direction: parallel, not moved by whole units.
+        let o = Vec3::new(1.7, 0.5 + 1e-6, -1.0);
+        assert_eq!(slab(min, max, o, safe_inverse(d), 1.0), None);
+        let tiny = Vec3::new(1e-40, 0.0, 1e-30);
+        let o = Vec3::new(0.0, 0.0, -4.0);
+        assert!(slab(min, max, o, safe_inverse(tiny), f32::INFINITY).is_some());
     }
 
     #[test]

@@ -30,6 +30,18 @@ use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES, SMALL_STACK, WIDE_S
 use super::node::{BvhNode, WideNode};
 use super::ray::{Hit, Ray};
 
+/// Box tests accept boxes entered up to this factor beyond the query's limit (`t_max`, or the
+/// best hit so far). The slab test is conservative for the exact ray, but the triangle test's
+/// distance is rounded and can lie a little *below* the exact one: a triangle reported at
+/// `t < t_max`, or at exactly the best `t` (a tie the lower input index must win), could sit in
+/// a box whose computed entry is just above that limit. Found by the fuzz target
+/// `shadow_rays_match_brute_force` (`crash-tie-on-cube-edge-box-pruned`: a ray through a
+/// cube's edge hit the two faces at the same t = 0.72222215, while the entry of the other
+/// face's flat box rounded to 0.72222222, so the higher index won). The triangle tests keep the
+/// exact limit. 2⁻¹² is far above the few ulps of that case; the triangle test's relative error
+/// is not bounded in general (grazing rays), so this makes a disagreement rare, not impossible.
+const BOX_T_SLACK: f32 = 1.0 + 1.0 / 4096.0;
+
 /// A BVH over triangles, for shadow rays and closest-hit queries.
 ///
 /// ```
@@ -144,6 +156,12 @@ impl Bvh {
         &self.skipped
     }
 
+    /// The input index of the triangle in leaf-order `slot` (as a [`ShadowHint`] names it),
+    /// `None` for a slot past the end.
+    pub fn triangle_index(&self, slot: u32) -> Option<u32> {
+        self.ids.get(slot as usize).copied()
+    }
+
     /// The binary tree's node array (root first), for inspection and statistics.
     pub fn nodes(&self) -> &[BvhNode] {
         &self.nodes
@@ -236,7 +254,7 @@ impl Bvh {
     /// testing a leaf as soon as its box is hit, stopping at the first hit. `N ≥ stack_need`.
     pub(super) fn any_hit<const N: usize>(&self, ray: &Ray, t_max: f32) -> Option<u32> {
         let lanes = RayLanes::new(ray.origin_a, ray.inv_dir);
-        let limit = Vec4::splat(t_max);
+        let limit = Vec4::splat(t_max * BOX_T_SLACK);
         let mut stack = [0u32; N];
         let mut sp = 0;
         let mut index = 0u32;
@@ -296,7 +314,8 @@ impl Bvh {
         let mut index = 0u32;
         loop {
             let node = &self.wide[index as usize];
-            let (mut mask, near) = lanes.slab_test(node, Vec4::splat(best_t));
+            let box_t = best_t * BOX_T_SLACK;
+            let (mut mask, near) = lanes.slab_test(node, Vec4::splat(box_t));
             let near = near.to_array();
             // The lanes hit, nearest first (at most four: insertion sort).
             let mut order = [0usize; 4];
@@ -322,7 +341,7 @@ impl Bvh {
             }
             for &lane in &order[..n] {
                 let count = node.count[lane] as usize;
-                if count == 0 || near[lane] > best_t {
+                if count == 0 || near[lane] > box_t {
                     continue;
                 }
                 // Equal t must still be considered for the tie-break, so the limit is the next
@@ -355,7 +374,7 @@ impl Bvh {
                 }
                 sp -= 1;
                 let (next, entry) = stack[sp];
-                if entry <= best_t {
+                if entry <= best_t * BOX_T_SLACK {
                     index = next;
                     break;
                 }

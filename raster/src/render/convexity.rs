@@ -20,12 +20,12 @@
 
 use std::collections::HashMap;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use crate::scene::Mesh;
 
 /// Relative tolerance (of the bounding-box diagonal) for "behind or on a plane".
-const TOLERANCE: f32 = 1e-5;
+const TOLERANCE: f64 = 1e-5;
 
 /// True if no ray leaving a point of the mesh towards a light (from the side the light is on)
 /// can hit the mesh again: the mesh is flat, or closed and convex. Zero-area triangles are
@@ -35,21 +35,33 @@ pub fn cannot_shadow_itself(mesh: &Mesh) -> bool {
     if faces.is_empty() {
         return true;
     }
-    let (lo, hi) = mesh
-        .positions
+    let tolerance = TOLERANCE * diagonal(&mesh.positions);
+    is_flat(mesh, &faces[0], tolerance) || is_closed_convex(&faces, tolerance)
+}
+
+/// The length of the bounding-box diagonal of `positions`, in f64: the f32 length overflows
+/// for coordinates beyond about 10¹⁹, which made every tolerance infinite.
+fn diagonal(positions: &[Vec3]) -> f64 {
+    let (lo, hi) = positions
         .iter()
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
             (lo.min(v), hi.max(v))
         });
-    let tolerance = TOLERANCE * (hi - lo).length();
-    is_flat(mesh, &faces[0], tolerance) || is_closed_convex(&faces, tolerance)
+    if positions.is_empty() {
+        0.0
+    } else {
+        (hi.as_dvec3() - lo.as_dvec3()).length()
+    }
 }
 
-/// A triangle by welded vertex ids, with its corners and unit normal.
+/// A triangle by welded vertex ids, with its corners and unit normal. Computed in f64, where
+/// the products and sums of f32 coordinates neither overflow nor underflow: in f32 the squared
+/// length of the cross product overflows for edges longer than about 10⁹ and underflows below
+/// about 10⁻¹⁰, and every face then looked degenerate, so any such mesh was accepted.
 struct Face {
     v: [u32; 3],
-    p: [Vec3; 3],
-    normal: Vec3,
+    p: [DVec3; 3],
+    normal: DVec3,
 }
 
 /// The non-degenerate triangles with vertices welded by position: corners closer than
@@ -61,7 +73,7 @@ fn welded_faces(mesh: &Mesh) -> Vec<Face> {
         .iter()
         .filter_map(|t| {
             let v = t.map(|i| weld[i as usize]);
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
             let n = (b - a).cross(c - a);
             let len = n.length();
             (v[0] != v[1] && v[1] != v[2] && v[0] != v[2] && len > 0.0 && len.is_finite()).then(
@@ -76,21 +88,23 @@ fn welded_faces(mesh: &Mesh) -> Vec<Face> {
 }
 
 /// Relative distance (of the bounding-box diagonal) within which positions are welded.
-const WELD: f32 = 1e-6;
+const WELD: f64 = 1e-6;
 
 /// One id per position; positions within `WELD · diagonal` of an earlier one share its id.
 /// A hash grid of that cell size: a match lies in one of the 27 cells around a point.
 fn weld_positions(positions: &[Vec3]) -> Vec<u32> {
-    let (lo, hi) = positions
+    let lo = positions
         .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        });
-    let cell = (WELD * (hi - lo).length()).max(f32::MIN_POSITIVE);
-    let key = |p: Vec3| ((p - lo) / cell).floor().as_ivec3().to_array();
+        .fold(DVec3::INFINITY, |lo, &v| lo.min(v.as_dvec3()));
+    // In f64 the cell of a mesh of subnormal f32 coordinates is still tiny against the mesh;
+    // clamping it to the smallest normal f32 welded such a mesh into one point (no faces, so
+    // accepted). Found by `convexity_is_sound`: `crash-subnormal-mesh-welded-to-a-point`.
+    let cell = (WELD * diagonal(positions)).max(f64::MIN_POSITIVE);
+    let key = |p: DVec3| ((p - lo) / cell).floor().as_ivec3().to_array();
     let mut grid: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
     let mut ids = Vec::with_capacity(positions.len());
-    for (index, &p) in positions.iter().enumerate() {
+    for (index, p) in positions.iter().enumerate() {
+        let p = p.as_dvec3();
         let [x, y, z] = key(p);
         let mut found = None;
         'search: for dx in -1..=1 {
@@ -100,7 +114,7 @@ fn weld_positions(positions: &[Vec3]) -> Vec<u32> {
                         continue;
                     };
                     for &j in list {
-                        if positions[j as usize].distance(p) <= cell {
+                        if positions[j as usize].as_dvec3().distance(p) <= cell {
                             found = Some(ids[j as usize]);
                             break 'search;
                         }
@@ -115,14 +129,14 @@ fn weld_positions(positions: &[Vec3]) -> Vec<u32> {
 }
 
 /// Every vertex on the plane of `face`.
-fn is_flat(mesh: &Mesh, face: &Face, tolerance: f32) -> bool {
+fn is_flat(mesh: &Mesh, face: &Face, tolerance: f64) -> bool {
     mesh.positions
         .iter()
-        .all(|&p| face.normal.dot(p - face.p[0]).abs() <= tolerance)
+        .all(|&p| face.normal.dot(p.as_dvec3() - face.p[0]).abs() <= tolerance)
 }
 
 /// Closed (two opposite faces per edge), connected and convex at every edge.
-fn is_closed_convex(faces: &[Face], tolerance: f32) -> bool {
+fn is_closed_convex(faces: &[Face], tolerance: f64) -> bool {
     // Directed edge (from, to) → the face it belongs to; a repeat is not a manifold.
     let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(faces.len() * 3);
     for (i, f) in faces.iter().enumerate() {
@@ -211,7 +225,7 @@ mod tests {
         welded_faces(mesh).iter().all(|f| {
             mesh.positions
                 .iter()
-                .all(|&p| f.normal.dot(p - f.p[0]) <= 1e-5)
+                .all(|&p| f.normal.dot(p.as_dvec3() - f.p[0]) <= 1e-5)
         })
     }
 
@@ -269,6 +283,44 @@ mod tests {
             t.swap(1, 2);
         }
         assert!(!cannot_shadow_itself(&inside_out));
+    }
+
+    /// Found by the fuzz target `convexity_is_sound` (`crash-huge-open-box-no-faces`,
+    /// `crash-huge-coordinates-infinite-tolerance`, `crash-subnormal-mesh-welded-to-a-point`,
+    /// the 2⁻¹⁴⁰ case): in f32 the face normals' squared lengths
+    /// overflowed for edges beyond about 10⁹ (underflowed below about 10⁻¹⁰) and the diagonal
+    /// overflowed for coordinates beyond about 10¹⁹, so every face looked degenerate or every
+    /// tolerance was infinite, and any mesh at those scales was accepted.
+    #[test]
+    fn the_test_holds_at_every_scale() {
+        let mut open = shapes::cuboid(Vec3::new(1.0, 2.0, 4.0));
+        open.triangles.truncate(open.triangles.len() - 2);
+        let mut dented = shapes::cuboid(Vec3::ONE);
+        let corner = dented.positions[0];
+        for p in &mut dented.positions {
+            if *p == corner {
+                *p *= 0.2;
+            }
+        }
+        for e in [-140, -120, -100, -60, -40, 0, 40, 60, 100, 120] {
+            // (2^e in two steps: `powi(-140)` is 1/2¹⁴⁰ = 1/∞ = 0 in f32.)
+            let s = Mat4::from_scale(Vec3::splat(2f32.powi(e / 2) * 2f32.powi(e - e / 2)));
+            assert!(!cannot_shadow_itself(&moved(open.clone(), s)), "open 2^{e}");
+            assert!(
+                !cannot_shadow_itself(&moved(dented.clone(), s)),
+                "dented 2^{e}"
+            );
+            let cube = moved(shapes::cuboid(Vec3::ONE), s);
+            assert!(cannot_shadow_itself(&cube), "cube 2^{e}");
+        }
+        // Coordinates near the f32 limit: the diagonal exceeds f32.
+        let mut huge = shapes::cuboid(Vec3::splat(2.0));
+        for p in &mut huge.positions {
+            *p *= 3e38;
+        }
+        assert!(cannot_shadow_itself(&huge));
+        huge.triangles.truncate(huge.triangles.len() - 2);
+        assert!(!cannot_shadow_itself(&huge));
     }
 
     #[test]

@@ -12,23 +12,29 @@
 //! | [`scene_parse_never_panics`] | arbitrary bytes → a scene or an error, a scene sound |
 //! | [`obj_load_never_panics`] | arbitrary bytes → a mesh or an error, a mesh valid |
 //! | [`raster_triangle_in_bounds`] | arbitrary clip-space triangles → coverage and depth as an oracle says |
+//! | [`shadow_rays_match_brute_force`] | BVH any-hit (plain, hinted) and closest hit against a brute-force loop |
+//! | [`convexity_is_sound`] | a mesh `cannot_shadow_itself` accepts is flat or convex by an exhaustive check |
 
 mod cache;
+mod convexity;
 pub mod input;
 mod parse;
 mod raster;
+mod shadow;
 mod table;
 
 pub use cache::{MAX_FUZZ_SAMPLES, cache_query_matches_exhaustive};
+pub use convexity::convexity_is_sound;
 pub use parse::{SMALL_MESH_OBJ, fuzz_origin, obj_load_never_panics, scene_parse_never_panics};
 pub use raster::raster_triangle_in_bounds;
+pub use shadow::shadow_rays_match_brute_force;
 pub use table::table_lookup_finite;
 
 /// A property: takes the fuzzer's bytes, panics when the property fails.
 pub type Property = fn(&[u8]);
 
 /// Every target by name, with its property: what the replay test and tools iterate over.
-pub const TARGETS: [(&str, Property); 5] = [
+pub const TARGETS: [(&str, Property); 7] = [
     (
         "cache_query_matches_exhaustive",
         cache_query_matches_exhaustive,
@@ -37,4 +43,9 @@ pub const TARGETS: [(&str, Property); 5] = [
     ("scene_parse_never_panics", scene_parse_never_panics),
     ("obj_load_never_panics", obj_load_never_panics),
     ("raster_triangle_in_bounds", raster_triangle_in_bounds),
+    (
+        "shadow_rays_match_brute_force",
+        shadow_rays_match_brute_force,
+    ),
+    ("convexity_is_sound", convexity_is_sound),
 ];
