@@ -31,26 +31,40 @@ const TOLERANCE: f64 = 1e-5;
 /// can hit the mesh again: the mesh is flat, or closed and convex. Zero-area triangles are
 /// ignored.
 pub fn cannot_shadow_itself(mesh: &Mesh) -> bool {
-    let faces = welded_faces(mesh);
+    let Some(bounds) = Bounds::of(&mesh.positions) else {
+        return true;
+    };
+    let faces = welded_faces(mesh, &bounds);
     if faces.is_empty() {
         return true;
     }
-    let tolerance = TOLERANCE * diagonal(&mesh.positions);
+    let tolerance = TOLERANCE * bounds.diagonal;
     is_flat(mesh, &faces[0], tolerance) || is_closed_convex(&faces, tolerance)
 }
 
-/// The length of the bounding-box diagonal of `positions`, in f64: the f32 length overflows
-/// for coordinates beyond about 10¹⁹, which made every tolerance infinite.
-fn diagonal(positions: &[Vec3]) -> f64 {
-    let (lo, hi) = positions
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        });
-    if positions.is_empty() {
-        0.0
-    } else {
-        (hi.as_dvec3() - lo.as_dvec3()).length()
+/// The smallest corner and the diagonal length of the positions' bounding box, in f64: the
+/// f32 length overflows for coordinates beyond about 10¹⁹, which made every tolerance
+/// infinite.
+struct Bounds {
+    lo: DVec3,
+    diagonal: f64,
+}
+
+impl Bounds {
+    /// `None` for no positions.
+    fn of(positions: &[Vec3]) -> Option<Bounds> {
+        if positions.is_empty() {
+            return None;
+        }
+        let (lo, hi) = positions
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v.as_dvec3()), hi.max(v.as_dvec3()))
+            });
+        Some(Bounds {
+            lo,
+            diagonal: (hi - lo).length(),
+        })
     }
 }
 
@@ -67,8 +81,8 @@ struct Face {
 /// The non-degenerate triangles with vertices welded by position: corners closer than
 /// [`WELD`] of the mesh size are one vertex (generated seams differ in the last bits:
 /// sin 2π is not 0 in floating point).
-fn welded_faces(mesh: &Mesh) -> Vec<Face> {
-    let weld = weld_positions(&mesh.positions);
+fn welded_faces(mesh: &Mesh, bounds: &Bounds) -> Vec<Face> {
+    let weld = weld_positions(&mesh.positions, bounds);
     mesh.triangles
         .iter()
         .filter_map(|t| {
@@ -92,14 +106,12 @@ const WELD: f64 = 1e-6;
 
 /// One id per position; positions within `WELD · diagonal` of an earlier one share its id.
 /// A hash grid of that cell size: a match lies in one of the 27 cells around a point.
-fn weld_positions(positions: &[Vec3]) -> Vec<u32> {
-    let lo = positions
-        .iter()
-        .fold(DVec3::INFINITY, |lo, &v| lo.min(v.as_dvec3()));
+fn weld_positions(positions: &[Vec3], bounds: &Bounds) -> Vec<u32> {
+    let lo = bounds.lo;
     // In f64 the cell of a mesh of subnormal f32 coordinates is still tiny against the mesh;
     // clamping it to the smallest normal f32 welded such a mesh into one point (no faces, so
     // accepted). Found by `convexity_is_sound`: `crash-subnormal-mesh-welded-to-a-point`.
-    let cell = (WELD * diagonal(positions)).max(f64::MIN_POSITIVE);
+    let cell = (WELD * bounds.diagonal).max(f64::MIN_POSITIVE);
     let key = |p: DVec3| ((p - lo) / cell).floor().as_ivec3().to_array();
     let mut grid: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
     let mut ids = Vec::with_capacity(positions.len());
@@ -222,7 +234,8 @@ mod tests {
 
     /// The exhaustive definition, for small meshes: every vertex behind every face's plane.
     fn every_vertex_behind_every_face(mesh: &Mesh) -> bool {
-        welded_faces(mesh).iter().all(|f| {
+        let bounds = Bounds::of(&mesh.positions).expect("a mesh with vertices");
+        welded_faces(mesh, &bounds).iter().all(|f| {
             mesh.positions
                 .iter()
                 .all(|&p| f.normal.dot(p.as_dvec3() - f.p[0]) <= 1e-5)

@@ -289,13 +289,13 @@ impl Shading<'_> {
                         }
                     });
                 }
-                let k = match &oc.local {
-                    Some(_) if self.exact_local_integral => {
+                let k = match (&oc.local, oc.uniform_k) {
+                    (Some(_), _) if self.exact_local_integral => {
                         exact_local_integral(&point.profile, oc.alpha)
                     }
-                    Some(_) if oc.uniform_k.is_some() => oc.uniform_k.unwrap_or_default(),
-                    Some(term) => term.lookup(&point),
-                    None => Vec3::ZERO,
+                    (Some(_), Some(k)) => k,
+                    (Some(term), None) => term.lookup(&point),
+                    (None, _) => Vec3::ZERO,
                 };
                 let settings = QuerySettings {
                     smoothing_radius: oc.alpha,
