@@ -389,15 +389,19 @@ fn run_scene(
     };
     let n = config.truth_count();
     log(&format!("{name}: ground truth, {n} samples"));
-    let truth = runner::render_once(
-        &runner::configure(&truth_scene, truth_setting, n, 1000),
-        true,
-    )?;
-    let reference = Reference::new(truth)?;
+    // The truth's samples are placed and lit once: the error split renders them again.
+    let start = Instant::now();
+    let truth_run = runner::configure(&truth_scene, truth_setting, n, 1000);
+    let truth_samples = crate::render::bake(&truth_run, false)?;
+    let placing = start.elapsed();
+    let truth = runner::render_once(&truth_run, true, Some(&truth_samples))?;
+    let mut reference = Reference::new(truth)?;
+    reference.time += placing;
     log(&format!("{name}: convergence check, {} samples", n / 2));
     let half = runner::render_once(
         &runner::configure(&truth_scene, truth_setting, n / 2, 1001),
         false,
+        None,
     )?;
     let convergence = compare(&half.image, &reference.image, Some(&reference.translucent))?;
     report.truths.push(TruthInfo {
@@ -439,15 +443,14 @@ fn run_scene(
     let sweep = smoothing_sweep(config, scene, &base, report, &reference, log)?;
     report.smoothing.extend(sweep);
     if let [(samples, lm), (_, n10)] = &split_runs[..] {
-        let mut matched = truth_scene.clone();
+        let mut matched = truth_run.clone();
         matched.render.smoothing =
             split::matched_smoothing(base.render.smoothing, reference.samples, *samples);
         log(&format!(
             "{name}: the truth again at k = {} (the α of {samples} samples), for the error split",
             matched.render.smoothing
         ));
-        let exact =
-            runner::render_once(&runner::configure(&matched, truth_setting, n, 1000), false)?;
+        let exact = runner::render_once(&matched, false, Some(&truth_samples))?;
         let exact_global: Vec<glam::Vec3> = exact.pixels.iter().map(|p| p.global).collect();
         let errors = |mask: &[bool]| {
             [lm, n10].map(|run| split::term_errors(&reference.exitance, &exact_global, run, mask))
@@ -614,8 +617,11 @@ fn exhaustive_check(
         method: SssMethod::Exhaustive,
         epsilon: config.split_epsilon,
     };
-    let exhaustive =
-        runner::render_once(&runner::configure(base, exhaustive_setting, n, seed), true)?;
+    let exhaustive = runner::render_once(
+        &runner::configure(base, exhaustive_setting, n, seed),
+        true,
+        None,
+    )?;
     let reference = Reference::new(exhaustive)?;
     // CPU per lookup is measured on one thread: two threads on this machine's two (shared)
     // cores do not scale perfectly, and the reference figure is CPU time per lookup.

@@ -18,7 +18,7 @@ use crate::output::{
     ErrorStats, NoiseStats, RgbImage, compare, default_band_radius, seed_noise, shadow_edge_band,
     translucent_mask,
 };
-use crate::render::{Render, RenderOptions, Timings, core_method, render};
+use crate::render::{ObjectSamples, Render, RenderOptions, Timings, core_method, render};
 use crate::scene::{SampleDensity, Scene, SssMethod};
 
 /// One method with its settings.
@@ -207,11 +207,17 @@ pub fn configure(base: &Scene, setting: MethodSetting, samples: u32, seed: u64) 
     scene
 }
 
-/// Renders with traversal statistics (and the irradiance layer when `reference_layers`).
-pub fn render_once(scene: &Scene, reference_layers: bool) -> Result<Render, BenchError> {
+/// Renders with traversal statistics (and the irradiance layer when `reference_layers`), from
+/// `baked` samples instead of placing and lighting new ones when given.
+pub fn render_once(
+    scene: &Scene,
+    reference_layers: bool,
+    baked: Option<&[ObjectSamples]>,
+) -> Result<Render, BenchError> {
     let options = RenderOptions {
         collect_stats: true,
         irradiance_layer: reference_layers,
+        baked,
         ..RenderOptions::default()
     };
     render(scene, &options).map_err(|e| BenchError::new(e.to_string()))
@@ -232,6 +238,7 @@ pub fn run_config(
         renders.push(render_once(
             &configure(base, setting, samples, seed),
             false,
+            None,
         )?);
     }
     let first = &renders[0];
@@ -288,7 +295,7 @@ mod tests {
             method: SssMethod::EdgeAware,
             epsilon: 0.5,
         };
-        let truth = render_once(&configure(&base, setting, 1500, 1), true).unwrap();
+        let truth = render_once(&configure(&base, setting, 1500, 1), true, None).unwrap();
         let reference = Reference::new(truth).unwrap();
         assert!(
             reference.band.contains(&true),
