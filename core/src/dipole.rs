@@ -174,6 +174,30 @@ impl Dipole {
         eta: f32,
     ) -> Result<Self, ParamError> {
         check_eta(eta)?;
+        Self::with_terms(
+            albedo,
+            sigma_t,
+            boundary_term(eta as f64),
+            total_reflectance(albedo, eta as f64),
+        )
+    }
+
+    /// The same α′ and η with a new σ_t′: what a texture-mapped mean free path changes per
+    /// shading point. Reuses the α′- and η-only terms (the boundary term A and Rd_total, four
+    /// of the six double-precision exponentials of [`Dipole::from_albedo_and_extinction`]);
+    /// bit-identical to it.
+    pub fn with_extinction(&self, sigma_t: f64, eta: f32) -> Result<Self, ParamError> {
+        check_eta(eta)?;
+        Self::with_terms(
+            self.albedo,
+            sigma_t,
+            boundary_term(eta as f64),
+            self.rd_total as f64,
+        )
+    }
+
+    /// The constructor behind both: α′, σ_t′, the boundary term A(η) and Rd_total(α′, η).
+    fn with_terms(albedo: f64, sigma_t: f64, a: f64, rd_total: f64) -> Result<Self, ParamError> {
         if !(albedo > 0.0 && albedo <= 1.0) {
             return Err(ParamError::OutOfRange {
                 name: "albedo",
@@ -186,7 +210,6 @@ impl Dipole {
                 value: sigma_t as f32,
             });
         }
-        let a = boundary_term(eta as f64);
         let z_r = 1.0 / sigma_t;
         let z_v = z_r * (1.0 + 4.0 * a / 3.0);
         let sigma_tr = sigma_t * math::sqrt64(3.0 * (1.0 - albedo));
@@ -203,7 +226,7 @@ impl Dipole {
             albedo,
             sigma_t: sigma_t as f32,
             rd_zero: rd_zero as f32,
-            rd_total: total_reflectance(albedo, eta as f64) as f32,
+            rd_total: rd_total as f32,
         };
         // Both source depths squared must be normal floats with headroom for r² (else Rd(0)
         // overflows or the profile underflows to nothing), and Rd(0) must be finite. `rd`
@@ -391,6 +414,22 @@ mod tests {
     /// Whole milk, red channel (reference sheet §1): σ_s′ = 2.55, σ_a = 0.0011 per mm, η 1.3.
     fn milk_red() -> Dipole {
         Dipole::from_coefficients(0.0011, 2.55, 1.3).unwrap()
+    }
+
+    /// The per-shading-point shortcut gives the constructor's bits, and its errors.
+    #[test]
+    fn with_extinction_equals_full_construction() {
+        for &(albedo, eta) in &[(0.3, 1.0), (0.9, 1.3), (0.999_9, 1.5), (1.0, 2.0)] {
+            let base = Dipole::from_albedo_and_extinction(albedo, 1.0, eta).unwrap();
+            for sigma_t in [1e-3, 0.37, 1.0, 25.0, 4e3] {
+                let fast = base.with_extinction(sigma_t, eta).unwrap();
+                let full = Dipole::from_albedo_and_extinction(albedo, sigma_t, eta).unwrap();
+                assert_eq!(alloc::format!("{fast:?}"), alloc::format!("{full:?}"));
+            }
+            assert!(base.with_extinction(f64::NAN, eta).is_err());
+            assert!(base.with_extinction(-1.0, eta).is_err());
+            assert!(base.with_extinction(1e-30, eta).is_err());
+        }
     }
 
     #[test]

@@ -92,7 +92,10 @@ pub(crate) const LN2_LO: f32 = -2.121_944_4e-4;
 pub(crate) const EXP_MIN_ARG: f32 = -87.3;
 
 /// e^x for x ≤ 0 by the same reduction and polynomial as the 8-lane version (used to test it
-/// lane-for-lane and by the scalar fallback's tests; the scalar path itself calls [`exp`]).
+/// lane-for-lane, and by the local-integral table's interpolation, where it costs a quarter of
+/// `libm::expf`; the scalar profile calls [`exp`]). Relative error below 4e-7; e^0 = 1
+/// exactly.
+#[inline]
 pub fn exp_nonpositive_poly(x: f32) -> f32 {
     if x.is_nan() {
         return x;

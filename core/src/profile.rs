@@ -177,7 +177,12 @@ impl Profile {
     ) -> Result<Self, ParamError> {
         let mut ch = self.channels;
         for (c, d) in ch.iter_mut().enumerate() {
-            *d = Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], self.eta)?;
+            // A constant K_d (only ℓ textured) keeps α′: reuse its Rd_total.
+            *d = if albedo[c] == d.albedo() {
+                d.with_extinction(sigma_t[c], self.eta)?
+            } else {
+                Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], self.eta)?
+            };
         }
         Ok(Profile {
             channels: ch,
