@@ -120,3 +120,19 @@ fn targets_corpora_and_properties_agree() {
         );
     }
 }
+
+/// The scene-parser seeds are copies of the shipped scenes (`fuzz/make_seeds.py`); a scene
+/// edited without re-running the script would leave the fuzzer starting from a stale file.
+#[test]
+fn scene_seeds_are_the_shipped_scenes() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let seeds = fuzz_dir().join("corpus/scene_parse_never_panics");
+    for name in ["default", "sphere-shadow", "textured-mfp"] {
+        let scene = fs::read(scenes.join(format!("{name}.toml"))).expect("shipped scene");
+        let seed = fs::read(seeds.join(format!("seed-{name}.toml"))).expect("seed");
+        assert!(
+            scene == seed,
+            "fuzz seed for scenes/{name}.toml is stale: run `python3 fuzz/make_seeds.py`"
+        );
+    }
+}
