@@ -101,10 +101,42 @@ fn quick_bench_writes_a_complete_report() {
         );
     }
 
+    // Claim 1's interleaved rounds: a row per scene and count, ratios inside their range.
+    let overhead = std::fs::read_to_string(out.join("overhead.csv")).unwrap();
+    let mut lines = overhead.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3 * 2, "{overhead}");
+    for row in &rows {
+        assert_eq!(row.len(), header.len());
+        let value = |name: &str| -> f64 { row[column(&header, name)].parse().unwrap() };
+        assert_eq!(value("rounds"), 2.0);
+        for name in [
+            "hierarchical_shading_s",
+            "local_global_shading_s",
+            "edge_aware_shading_s",
+        ] {
+            assert!(value(name) > 0.0, "{name} in {row:?}");
+        }
+        for ratio in [
+            "vs_hierarchical",
+            "vs_local_global",
+            "per_lookup_vs_hierarchical",
+        ] {
+            let (lo, mid, hi) = (
+                value(&format!("{ratio}_min")),
+                value(&format!("{ratio}_median")),
+                value(&format!("{ratio}_max")),
+            );
+            assert!(lo <= mid && mid <= hi && lo > -1.0, "{ratio} in {row:?}");
+        }
+    }
+
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     for needle in [
         "## Ground truth",
         "### 1. Edge-aware overhead",
+        "interleaved rounds",
         "### 2. Shadow edges",
         "for several smoothing radii",
         "Where the error comes from",

@@ -7,10 +7,12 @@
 //!     for each sample count × method (hierarchical at each ε, local-global, edge-aware):
 //!         render once per seed → median time per phase, nodes per lookup, memory,
 //!         error (translucent pixels, shadow-edge band) against the truth, seed noise
+//!     claim 1:  per count, the three methods at equal ε on one baked sample set, rendered
+//!               in interleaved rounds (overhead.rs): medians of per-round ratios
 //!     sphere:   exhaustive sum at 18.5k samples vs hierarchical at several ε (speed claim)
 //!     textured: the power-of-two K table against K by quadrature at every pixel
 //!     default:  the shipped `lucent` render at 512², written to PNG + EXR, timed end to end
-//! report: report.md, results.csv, <scene>-error-vs-time.png, <scene>-figure1.png
+//! report: report.md, results.csv, overhead.csv, <scene>-error-vs-time.png, <scene>-figure1.png
 //! ```
 //!
 //! **Ground truth.** The issue asks for the exhaustive sum over a sample set much denser
@@ -28,6 +30,7 @@
 //! samples.
 
 mod figures;
+mod overhead;
 mod report;
 mod runner;
 mod scenes;
@@ -37,7 +40,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-pub use report::{write_csv, write_markdown};
+pub use overhead::{OverheadRow, Spread};
+pub use report::{write_csv, write_markdown, write_overhead_csv};
 pub use runner::{MethodSetting, Reference, RunResult};
 pub use scenes::BenchScene;
 pub use split::TermErrors;
@@ -103,6 +107,8 @@ pub struct BenchConfig {
     /// Smoothing factors k (α = k·√Ā) at which local-global and edge-aware are compared at
     /// the sheet count (claim 2); the scene's own k is the one every other run uses.
     pub smoothings: Vec<f32>,
+    /// Interleaved rounds of the claim-1 overhead measurement per scene and count (0: skip).
+    pub overhead_rounds: usize,
     /// Samples of the exhaustive-sum comparison on the sphere.
     pub exhaustive_count: u32,
     /// ε values compared with the exhaustive sum.
@@ -129,6 +135,7 @@ impl BenchConfig {
             truth_epsilon: 0.02,
             sheet_count: 23_000,
             smoothings: vec![1.0, 1.5, 2.0, 3.0],
+            overhead_rounds: 5,
             exhaustive_count: 18_500,
             exhaustive_epsilons: vec![0.05, 0.25, 0.5, 0.75, 1.0, 2.0],
             end_to_end: true,
@@ -150,6 +157,7 @@ impl BenchConfig {
             truth_epsilon: 0.05,
             sheet_count: 8_000,
             smoothings: vec![1.5, 3.0],
+            overhead_rounds: 2,
             exhaustive_count: 2_000,
             exhaustive_epsilons: vec![0.05, 0.5],
             end_to_end: false,
@@ -206,6 +214,9 @@ impl BenchConfig {
             .any(|k| !(k.is_finite() && *k > 0.0 && *k <= 16.0))
         {
             return bad("every smoothing factor k must be in (0, 16]");
+        }
+        if self.overhead_rounds > 100 {
+            return bad("overhead rounds must be at most 100");
         }
         if self.truth_factor < 2 {
             return bad("the truth factor must be at least 2 (the convergence check halves it)");
@@ -317,6 +328,8 @@ pub struct BenchReport {
     pub smoothing: Vec<SmoothingRow>,
     /// Their errors split into the two terms, per scene.
     pub splits: Vec<ErrorSplit>,
+    /// Claim 1 by interleaved rounds, per scene and count.
+    pub overhead: Vec<OverheadRow>,
     /// The textured scene's table check.
     pub table: Option<TableCheck>,
     /// The default scene end to end (render + PNG + EXR).
@@ -345,6 +358,7 @@ pub fn run(
         exhaustive: Vec::new(),
         smoothing: Vec::new(),
         splits: Vec::new(),
+        overhead: Vec::new(),
         table: None,
         end_to_end: None,
         threads: 0,
@@ -363,6 +377,7 @@ pub fn run(
     report.wall = start.elapsed();
     write_markdown(&report, &out.join("report.md"))?;
     write_csv(&report, &out.join("results.csv"))?;
+    write_overhead_csv(&report, &out.join("overhead.csv"))?;
     log(&format!(
         "report: {} ({:.0} s)",
         out.join("report.md").display(),
@@ -438,6 +453,25 @@ fn run_scene(
                 sheet_images.push((setting, first.image));
             }
             report.runs.push(result);
+        }
+    }
+    if config.overhead_rounds > 0 {
+        for &count in &config.counts {
+            let row = overhead::measure(
+                &base,
+                scene,
+                count,
+                config.split_epsilon,
+                config.overhead_rounds,
+                config.seeds[0],
+            )?;
+            log(&format!(
+                "{name}: {count:>7} samples, overhead over {} interleaved rounds: edge-aware {:+.1}% vs hierarchical, {:+.1}% vs local-global",
+                row.rounds,
+                row.vs_hierarchical.median * 100.0,
+                row.vs_local_global.median * 100.0
+            ));
+            report.overhead.push(row);
         }
     }
     let sweep = smoothing_sweep(config, scene, &base, report, &reference, log)?;
@@ -711,5 +745,6 @@ mod tests {
         check(|c| c.smoothings = vec![f32::INFINITY], "smoothing");
         check(|c| c.scenes.clear(), "scene");
         check(|c| c.threads = Some(0), "threads");
+        check(|c| c.overhead_rounds = 1000, "overhead rounds");
     }
 }

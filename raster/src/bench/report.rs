@@ -1,6 +1,6 @@
 //! The benchmark's tables: `report.md` (per-scene tables, the ground truth's convergence, and
-//! the four published claims, each with its verdict) and `results.csv` (one row per
-//! configuration, for plotting elsewhere).
+//! the four published claims, each with its verdict), `results.csv` (one row per
+//! configuration, for plotting elsewhere) and `overhead.csv` (claim 1's interleaved rounds).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -197,6 +197,8 @@ fn claims(report: &BenchReport) -> String {
             }
         }
     }
+
+    overhead_table(report, &mut s);
 
     let n = c.sheet_count;
     let four = c.counts.iter().copied().filter(|&k| k >= 4 * n).min();
@@ -401,6 +403,98 @@ pub fn write_markdown(report: &BenchReport, path: &Path) -> Result<(), BenchErro
                 );
             }
         }
+    }
+    write_file(path, &s)
+}
+
+/// Claim 1 from the interleaved rounds (`overhead.rs`), with the medians over scenes.
+fn overhead_table(report: &BenchReport, s: &mut String) {
+    if report.overhead.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "\nThe same claim measured on its own, robust to the machine's load: per scene and count the three methods render one baked sample set in {} interleaved rounds (the order rotating), and each round gives its own ratios; the table lists their median and range (`raster/src/bench/overhead.rs`).\n",
+        report.config.overhead_rounds
+    );
+    let _ = writeln!(
+        s,
+        "| scene | samples | hierarchical | local-global | edge-aware | vs hierarchical | vs local-global | per lookup vs hierarchical |\n|---|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    let spread = |x: super::Spread| {
+        format!(
+            "{:+.1}% ({:+.1} … {:+.1})",
+            x.median * 100.0,
+            x.min * 100.0,
+            x.max * 100.0
+        )
+    };
+    for row in &report.overhead {
+        let ms = row.shading.map(|t| t.as_secs_f64() * 1e3);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.1} ms | {:.1} ms | {:.1} ms | {} | {} | {} |",
+            row.scene.name(),
+            row.samples,
+            ms[0],
+            ms[1],
+            ms[2],
+            spread(row.vs_hierarchical),
+            spread(row.vs_local_global),
+            spread(row.per_lookup_vs_hierarchical)
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n| scene | median over counts: vs hierarchical | per lookup vs hierarchical | vs local-global |\n|---|---:|---:|---:|"
+    );
+    for &scene in &report.config.scenes {
+        let rows: Vec<_> = report
+            .overhead
+            .iter()
+            .filter(|r| r.scene == scene)
+            .collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let med = |f: fn(&super::OverheadRow) -> f64| {
+            super::Spread::of(rows.iter().map(|r| f(r)).collect()).median * 100.0
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {:+.1}% | {:+.1}% | {:+.1}% |",
+            scene.name(),
+            med(|r| r.vs_hierarchical.median),
+            med(|r| r.per_lookup_vs_hierarchical.median),
+            med(|r| r.vs_local_global.median)
+        );
+    }
+}
+
+/// The header of `overhead.csv` (one row per scene and count follows).
+pub const OVERHEAD_CSV_HEADER: &str = "scene,samples_requested,rounds,hierarchical_shading_s,local_global_shading_s,edge_aware_shading_s,vs_hierarchical_median,vs_hierarchical_min,vs_hierarchical_max,vs_local_global_median,vs_local_global_min,vs_local_global_max,per_lookup_vs_hierarchical_median,per_lookup_vs_hierarchical_min,per_lookup_vs_hierarchical_max";
+
+/// Writes `overhead.csv`: claim 1's interleaved measurement (ratios minus one).
+pub fn write_overhead_csv(report: &BenchReport, path: &Path) -> Result<(), BenchError> {
+    let mut s = String::new();
+    let _ = writeln!(s, "{OVERHEAD_CSV_HEADER}");
+    for r in &report.overhead {
+        let [h, l, e] = r.shading.map(|t| t.as_secs_f64());
+        let _ = write!(
+            s,
+            "{},{},{},{h},{l},{e}",
+            r.scene.name(),
+            r.samples,
+            r.rounds
+        );
+        for x in [
+            r.vs_hierarchical,
+            r.vs_local_global,
+            r.per_lookup_vs_hierarchical,
+        ] {
+            let _ = write!(s, ",{},{},{}", x.median, x.min, x.max);
+        }
+        let _ = writeln!(s);
     }
     write_file(path, &s)
 }
