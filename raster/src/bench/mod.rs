@@ -122,7 +122,7 @@ pub struct BenchConfig {
 }
 
 impl BenchConfig {
-    /// The full experiment (about 5 minutes on two cores).
+    /// The full experiment (5–9 minutes on two cores, with the host's load).
     pub fn full() -> Self {
         BenchConfig {
             resolution: 512,
