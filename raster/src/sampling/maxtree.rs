@@ -127,6 +127,85 @@ impl MaxTree {
             }
         }
     }
+
+    /// [`MaxTree::update`] for several runs of leaves whose weights have **fallen** (never
+    /// risen), `ranges` ascending and disjoint (a removal's neighbourhood): each level is
+    /// brought up to date once for all of them, so that the upper entries the runs share are
+    /// rescanned once instead of once per run, and a run of leaves is rescanned only if its
+    /// heaviest leaf was among those changed. The tree ends in the same state as after one
+    /// `update` per run (every entry is the best of its children, ties to the lower index,
+    /// whatever order it was recomputed in).
+    pub(super) fn update_ranges<L>(
+        &mut self,
+        leaves: &[L],
+        weight: impl Fn(&L) -> f32,
+        ranges: &[(u32, u32)],
+    ) {
+        const MAX_RUNS: usize = 16;
+        debug_assert!(
+            ranges.windows(2).all(|w| w[0].1 <= w[1].0),
+            "runs not ascending"
+        );
+        if ranges.len() > MAX_RUNS {
+            for &(a, b) in ranges {
+                self.update(leaves, &weight, a as usize, b as usize);
+            }
+            return;
+        }
+        // Per run: its span of entries at the current level, and whether an entry it
+        // recomputed there changed (only then can its parents be stale). Above the leaves, an
+        // entry another run recomputed first is skipped: that run carries the flag.
+        //
+        // Weights only fall (the caller subtracts non-negative kernel values, and removal and
+        // locking lower a weight to −∞ or f32::MIN), so a run of leaves whose heaviest leaf is
+        // untouched keeps it: only the runs whose best leaf lies in a changed range are
+        // rescanned (each by the range holding that leaf).
+        let mut spans = [(0usize, 0usize, false); MAX_RUNS];
+        let mut any = false;
+        for (span, &(a, b)) in spans.iter_mut().zip(ranges) {
+            if a >= b {
+                continue;
+            }
+            let (lo, hi) = (a as usize / FANOUT, (b as usize - 1) / FANOUT);
+            let mut changed = false;
+            for g in lo..=hi {
+                if !(a..b).contains(&self.levels[0][g].leaf) {
+                    continue;
+                }
+                let first = g * FANOUT;
+                let run = &leaves[first..(first + FANOUT).min(leaves.len())];
+                let e = Self::best_leaf(run, first, &weight);
+                changed |= e != self.levels[0][g];
+                self.levels[0][g] = e;
+            }
+            *span = (lo, hi, changed);
+            any |= changed;
+        }
+        for level in 1..self.levels.len() {
+            if !any {
+                return;
+            }
+            any = false;
+            let (below, here) = self.levels.split_at_mut(level);
+            let (below, here) = (&below[level - 1], &mut here[0]);
+            let mut done = None::<usize>;
+            for span in spans.iter_mut().take(ranges.len()) {
+                let (lo, hi) = (span.0 / FANOUT, span.1 / FANOUT);
+                let mut changed = false;
+                if span.2 {
+                    for g in lo.max(done.map_or(0, |d| d + 1))..=hi {
+                        let first = g * FANOUT;
+                        let e = best_of(&below[first..(first + FANOUT).min(below.len())]);
+                        changed |= e != here[g];
+                        here[g] = e;
+                    }
+                    done = Some(done.map_or(hi, |d| d.max(hi)));
+                }
+                *span = (lo, hi, changed);
+                any |= changed;
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -157,6 +236,38 @@ mod tests {
                     *x -= rng.next_below(3) as f32;
                 }
                 tree.update(&w, |&x| x, a, b);
+            }
+        }
+    }
+
+    /// Batched updates leave the tree exactly as one update per run does.
+    #[test]
+    fn update_ranges_equals_one_update_per_run() {
+        let mut rng = Pcg32::new(5, 9);
+        for n in [1usize, 16, 17, 255, 4097, 20_000] {
+            let mut w: Vec<f32> = (0..n).map(|_| rng.next_below(50) as f32).collect();
+            let mut batched = MaxTree::new(&w, |&x| x);
+            let mut single = MaxTree::new(&w, |&x| x);
+            for _ in 0..300 {
+                // Up to 12 ascending, disjoint runs (some empty, some adjacent).
+                let mut ranges = Vec::new();
+                let mut at = rng.next_below(n as u32) as usize;
+                for _ in 0..=rng.next_below(12) {
+                    let a = (at + rng.next_below(3) as usize * rng.next_below(200) as usize).min(n);
+                    let b = (a + rng.next_below(70) as usize).min(n);
+                    ranges.push((a as u32, b as u32));
+                    at = b;
+                }
+                for &(a, b) in &ranges {
+                    for x in &mut w[a as usize..b as usize] {
+                        *x -= rng.next_below(4) as f32;
+                    }
+                }
+                batched.update_ranges(&w, |&x| x, &ranges);
+                for &(a, b) in &ranges {
+                    single.update(&w, |&x| x, a as usize, b as usize);
+                }
+                assert_eq!(batched.levels, single.levels, "n = {n}, runs {ranges:?}");
             }
         }
     }

@@ -149,11 +149,11 @@ pub fn poisson_samples(
         let Some(i) = tree.top() else { break };
         let p = points.position(i as usize);
         points.xyzw[i as usize][3] = f32::NEG_INFINITY;
-        for &(a, b) in grid.ranges_near(i) {
-            let (a, b) = (a as usize, b as usize);
-            kernel.subtract(p, &mut points.xyzw[a..b]);
-            tree.update(&points.xyzw, weight_of, a, b);
+        let ranges = grid.ranges_near(i);
+        for &(a, b) in ranges {
+            kernel.subtract(p, &mut points.xyzw[a as usize..b as usize]);
         }
+        tree.update_ranges(&points.xyzw, weight_of, ranges);
         let g = group_of(order[i as usize]);
         live[g] -= 1;
         if live[g] == quota[g] {
