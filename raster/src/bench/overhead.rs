@@ -22,7 +22,7 @@
 use std::time::Duration;
 
 use super::BenchError;
-use super::runner::{MethodSetting, configure, render_once};
+use super::runner::{MethodSetting, configure, median, render_once};
 use super::scenes::BenchScene;
 use crate::render::bake;
 use crate::scene::{Scene, SssMethod};
@@ -119,16 +119,11 @@ pub fn measure(
                 .collect(),
         )
     };
-    let median = |v: &[Duration]| {
-        let mut v = v.to_vec();
-        v.sort();
-        v[v.len() / 2]
-    };
     Ok(OverheadRow {
         scene,
         samples,
         rounds,
-        shading: [0, 1, 2].map(|m| median(&shading[m])),
+        shading: shading.clone().map(median),
         vs_hierarchical: ratios(&shading, 0),
         vs_local_global: ratios(&shading, 1),
         per_lookup_vs_hierarchical: ratios(&translucent, 0),
