@@ -104,12 +104,8 @@ impl MaxTree {
         }
         let (mut lo, mut hi) = (start / FANOUT, (end - 1) / FANOUT);
         let mut changed = false;
-        for (g, slot) in self.levels[0].iter_mut().enumerate().take(hi + 1).skip(lo) {
-            let first = g * FANOUT;
-            let run = &leaves[first..(first + FANOUT).min(leaves.len())];
-            let e = Self::best_leaf(run, first, &weight);
-            changed |= e != *slot;
-            *slot = e;
+        for g in lo..=hi {
+            changed |= self.rescan_leaves(leaves, &weight, g);
         }
         for level in 1..self.levels.len() {
             if !changed {
@@ -117,15 +113,33 @@ impl MaxTree {
             }
             changed = false;
             (lo, hi) = (lo / FANOUT, hi / FANOUT);
-            let (below, here) = self.levels.split_at_mut(level);
-            let (below, here) = (&below[level - 1], &mut here[0]);
-            for (g, slot) in here.iter_mut().enumerate().take(hi + 1).skip(lo) {
-                let first = g * FANOUT;
-                let e = best_of(&below[first..(first + FANOUT).min(below.len())]);
-                changed |= e != *slot;
-                *slot = e;
+            for g in lo..=hi {
+                changed |= self.rescan_entry(level, g);
             }
         }
+    }
+
+    /// Recomputes level-0 entry `g` from its run of leaves; true if it changed.
+    #[inline(always)]
+    fn rescan_leaves<L>(&mut self, leaves: &[L], weight: impl Fn(&L) -> f32, g: usize) -> bool {
+        let first = g * FANOUT;
+        let run = &leaves[first..(first + FANOUT).min(leaves.len())];
+        let e = Self::best_leaf(run, first, weight);
+        let changed = e != self.levels[0][g];
+        self.levels[0][g] = e;
+        changed
+    }
+
+    /// Recomputes entry `g` of `level` (≥ 1) from the level below; true if it changed.
+    #[inline(always)]
+    fn rescan_entry(&mut self, level: usize, g: usize) -> bool {
+        let (below, here) = self.levels.split_at_mut(level);
+        let below = &below[level - 1];
+        let first = g * FANOUT;
+        let e = best_of(&below[first..(first + FANOUT).min(below.len())]);
+        let changed = e != here[0][g];
+        here[0][g] = e;
+        changed
     }
 
     /// [`MaxTree::update`] for several runs of leaves whose weights have **fallen** (never
@@ -169,14 +183,9 @@ impl MaxTree {
             let (lo, hi) = (a as usize / FANOUT, (b as usize - 1) / FANOUT);
             let mut changed = false;
             for g in lo..=hi {
-                if !(a..b).contains(&self.levels[0][g].leaf) {
-                    continue;
+                if (a..b).contains(&self.levels[0][g].leaf) {
+                    changed |= self.rescan_leaves(leaves, &weight, g);
                 }
-                let first = g * FANOUT;
-                let run = &leaves[first..(first + FANOUT).min(leaves.len())];
-                let e = Self::best_leaf(run, first, &weight);
-                changed |= e != self.levels[0][g];
-                self.levels[0][g] = e;
             }
             *span = (lo, hi, changed);
             any |= changed;
@@ -186,18 +195,13 @@ impl MaxTree {
                 return;
             }
             any = false;
-            let (below, here) = self.levels.split_at_mut(level);
-            let (below, here) = (&below[level - 1], &mut here[0]);
             let mut done = None::<usize>;
             for span in spans.iter_mut().take(ranges.len()) {
                 let (lo, hi) = (span.0 / FANOUT, span.1 / FANOUT);
                 let mut changed = false;
                 if span.2 {
                     for g in lo.max(done.map_or(0, |d| d + 1))..=hi {
-                        let first = g * FANOUT;
-                        let e = best_of(&below[first..(first + FANOUT).min(below.len())]);
-                        changed |= e != here[g];
-                        here[g] = e;
+                        changed |= self.rescan_entry(level, g);
                     }
                     done = Some(done.map_or(hi, |d| d.max(hi)));
                 }
