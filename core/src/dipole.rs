@@ -185,9 +185,15 @@ impl Dipole {
     /// The same α′ and η with a new σ_t′: what a texture-mapped mean free path changes per
     /// shading point. Reuses the α′- and η-only terms (the boundary term A and Rd_total, four
     /// of the six double-precision exponentials of [`Dipole::from_albedo_and_extinction`]);
-    /// bit-identical to it.
-    pub fn with_extinction(&self, sigma_t: f64, eta: f32) -> Result<Self, ParamError> {
+    /// bit-identical to it. `eta` must be the η this dipole was built with (the dipole does
+    /// not keep it; a [`crate::Profile`] does), so this stays inside the crate.
+    pub(crate) fn with_extinction(&self, sigma_t: f64, eta: f32) -> Result<Self, ParamError> {
         check_eta(eta)?;
+        debug_assert_eq!(
+            self.rd_total,
+            total_reflectance(self.albedo, eta as f64) as f32,
+            "with_extinction called with another η than the dipole's"
+        );
         Self::with_terms(
             self.albedo,
             sigma_t,

@@ -123,10 +123,10 @@ pub fn measure(
         scene,
         samples,
         rounds,
-        shading: shading.clone().map(median),
         vs_hierarchical: ratios(&shading, 0),
         vs_local_global: ratios(&shading, 1),
         per_lookup_vs_hierarchical: ratios(&translucent, 0),
+        shading: shading.map(median),
     })
 }
 
