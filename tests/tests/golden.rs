@@ -247,3 +247,49 @@ fn images_and_baked_samples_are_identical_for_any_thread_count() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// No translucent pixel of any golden is black or darkened while light leaves the surface
+/// there: wherever the exitance is positive, the radiance is at least F_t at a grazing 89.5°
+/// allows (about 5% of its value at normal incidence, for η up to 2.5) relative to the image's
+/// typical radiance per unit exitance. Shading normals that face away from the camera at
+/// silhouettes once made F_t = 0 there.
+#[test]
+fn goldens_have_no_dark_translucent_pixels() {
+    let mut checked = 0;
+    for (name, _) in scenes() {
+        let path = golden(&format!("{name}.exr"));
+        let exr = read_exr(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let Some(exitance) = exr.layers.iter().find_map(|l| match &l.data {
+            LayerData::Rgb(v) if l.name == LAYER_EXITANCE => Some(v),
+            _ => None,
+        }) else {
+            panic!("{name}: no exitance layer");
+        };
+        let ratios: Vec<(usize, f32)> = exitance
+            .iter()
+            .zip(exr.beauty.pixels())
+            .enumerate()
+            .filter(|(_, (m, _))| m.element_sum() > 0.0)
+            .map(|(i, (m, l))| (i, l.element_sum() / m.element_sum()))
+            .collect();
+        if ratios.is_empty() {
+            continue;
+        }
+        let mut sorted: Vec<f32> = ratios.iter().map(|r| r.1).collect();
+        sorted.sort_by(f32::total_cmp);
+        let median = sorted[sorted.len() / 2];
+        let dark: Vec<usize> = ratios
+            .iter()
+            .filter(|r| !(r.1 >= 0.05 * median))
+            .map(|r| r.0)
+            .collect();
+        assert!(
+            dark.is_empty(),
+            "{name}: {} translucent pixels darker than Fresnel allows (first: pixel {})",
+            dark.len(),
+            dark[0]
+        );
+        checked += ratios.len();
+    }
+    assert!(checked > 1000, "only {checked} translucent pixels checked");
+}

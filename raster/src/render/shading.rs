@@ -246,12 +246,13 @@ impl Shading<'_> {
             (0..3).fold(Vec2::ZERO, |t, k| t + uv[tri[k] as usize] * b[k])
         });
         let view = (self.camera.position - position).normalize_or(Vec3::Z);
-        let geometric = (v[1] - v[0]).cross(v[2] - v[0]);
+        let mut geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
         if geometric.dot(view) < 0.0 {
             // Seen from behind (open meshes): shade the side the camera sees.
             normal = -normal;
+            geometric = -geometric;
         }
-        let cos_out = normal.dot(view).clamp(0.0, 1.0);
+        let cos_out = outgoing_cosine(normal, geometric, view);
         let mut out = Surface {
             position,
             ..Surface::default()
@@ -325,6 +326,19 @@ impl Shading<'_> {
     }
 }
 
+/// The cosine of the outgoing direction for the Fresnel transmittance F_t(η, cos θ_o).
+///
+/// The camera sees the triangle's front, so the geometric normal (turned towards the camera)
+/// has a positive cosine wherever a pixel is covered; the interpolated shading normal need not:
+/// at silhouettes and creases it can face away, and its cosine, clamped to 0, made F_t = 0 and
+/// the pixel black although light leaves the surface there. The shading normal's cosine is
+/// used where it is larger, so smooth meshes keep smooth Fresnel falloff, and the geometric
+/// cosine bounds it from below. Both terms are continuous over a triangle, so their maximum is
+/// too.
+fn outgoing_cosine(shading: Vec3, geometric: Vec3, view: Vec3) -> f32 {
+    shading.dot(view).max(geometric.dot(view)).clamp(0.0, 1.0)
+}
+
 #[derive(Clone, Copy, Debug, Default)]
 struct Surface {
     position: Vec3,
@@ -333,4 +347,101 @@ struct Surface {
     local: Vec3,
     global: Vec3,
     irradiance: Vec3,
+}
+
+#[cfg(test)]
+mod tests {
+    use std::borrow::Cow;
+
+    use glam::Vec3;
+    use lucent_core::{Distance, Profile, fresnel};
+
+    use super::outgoing_cosine;
+    use crate::render::{RenderOptions, render};
+    use crate::scene::{SceneOrigin, parse_scene};
+
+    #[test]
+    fn the_outgoing_cosine_is_positive_on_every_visible_surface() {
+        let view = Vec3::Z;
+        let facing = Vec3::Z;
+        // A shading normal that faces away (a silhouette): the geometric cosine stands in.
+        let away = Vec3::new(0.9, 0.0, -0.3).normalize();
+        let tilted = Vec3::new(0.6, 0.0, 0.8);
+        assert_eq!(outgoing_cosine(away, tilted, view), 0.8);
+        // Where the shading normal sees the camera better, it is used (smooth falloff).
+        assert_eq!(outgoing_cosine(facing, tilted, view), 1.0);
+        assert_eq!(outgoing_cosine(tilted, facing, view), 1.0);
+    }
+
+    /// A lit translucent square facing the camera whose vertex normals all face away from
+    /// it (as at a coarse mesh's silhouette): its radiance must be F_t at the cosine of the
+    /// surface the camera sees, not 0.
+    #[test]
+    fn shading_normals_facing_away_do_not_blacken_a_visible_surface() {
+        let (nx, nz) = (100f32.to_radians().sin(), 100f32.to_radians().cos());
+        let obj = format!(
+            "v -20 -20 0\nv 20 -20 0\nv 20 20 0\nv -20 20 0\nvn {nx} 0 {nz}\n\
+             f 1//1 2//1 3//1\nf 1//1 3//1 4//1\n"
+        );
+        let text = r#"
+[camera]
+position = [0.0, 0.0, 30.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 10.0
+width = 12
+height = 12
+
+[[object]]
+name = "square"
+obj = "square.obj"
+material = "wax"
+
+[material.wax]
+type = "translucent"
+kd = [0.5, 0.3, 0.15]
+mean_free_path = 0.5
+eta = 1.4
+
+[[light]]
+type = "directional"
+direction = [-0.9, 0.0, -0.43588989]
+irradiance = 2.0
+
+[render]
+method = "edge-aware"
+samples = 20000
+aa = 1
+"#;
+        let scene = parse_scene(
+            text,
+            &SceneOrigin::Embedded {
+                name: "square.toml".into(),
+                files: vec![("square.obj".into(), Cow::Owned(obj.into_bytes()))],
+            },
+        )
+        .unwrap();
+        let r = render(&scene, &RenderOptions::default()).unwrap();
+        let profile = Profile::from_reflectance(
+            Vec3::new(0.5, 0.3, 0.15),
+            Distance::MeanFreePath(Vec3::splat(0.5)),
+            1.4,
+        )
+        .unwrap();
+        // The camera is 30 units away and the view 5 units across: every pixel sees the
+        // square within 5° of its normal, where F_t differs from normal incidence by < 0.1%.
+        assert!(
+            (fresnel::transmittance(1.4, 5f32.to_radians().cos())
+                / fresnel::transmittance(1.4, 1.0)
+                - 1.0)
+                .abs()
+                < 1e-3
+        );
+        for p in &r.pixels {
+            assert!(p.exitance.min_element() > 0.0, "exitance {}", p.exitance);
+            let want = profile.radiance(p.exitance, 1.0);
+            let error = ((p.color - want).abs() / want).max_element();
+            assert!(error < 2e-3, "color {} vs {want}", p.color);
+        }
+    }
 }
