@@ -229,7 +229,9 @@ impl TranslucentShader {
         let albedo: [f64; 3] = match kd {
             KdSource::Constant(a) => *a,
             KdSource::Texture(t, inverter) => {
-                let lo = texel_range(t).0.clamp(Vec3::splat(0.001), Vec3::splat(0.999));
+                let lo = texel_range(t)
+                    .0
+                    .clamp(Vec3::splat(0.001), Vec3::splat(0.999));
                 [
                     inverter.albedo(lo.x),
                     inverter.albedo(lo.y),

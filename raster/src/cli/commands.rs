@@ -276,7 +276,8 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
         scene.render.seed = seed;
     }
     let start = std::time::Instant::now();
-    let (sets, plan) = render::bake_planned(&scene, !args.quiet, true).map_err(|e| e.to_string())?;
+    let (sets, plan) =
+        render::bake_planned(&scene, !args.quiet, true).map_err(|e| e.to_string())?;
     let names: Vec<String> = scene.objects.iter().map(|o| o.name.clone()).collect();
     let source = scene
         .source

@@ -86,8 +86,8 @@ pub struct RenderArgs {
     /// Irradiance sample spacing in scene units (instead of a count).
     #[arg(long, value_name = "DISTANCE")]
     pub spacing: Option<f32>,
-    /// The most samples `auto` may place (default: what half the available memory holds, at
-    /// most 33554432).
+    /// The most samples `auto` may place (default: what half the available memory holds at
+    /// 600 bytes per sample, at most 33554432).
     #[arg(long, value_name = "N")]
     pub max_samples: Option<u64>,
     /// Image width in pixels.
@@ -156,8 +156,8 @@ pub struct BakeArgs {
     /// Irradiance sample spacing in scene units (instead of a count).
     #[arg(long, value_name = "DISTANCE")]
     pub spacing: Option<f32>,
-    /// The most samples `auto` may place (default: what half the available memory holds, at
-    /// most 33554432).
+    /// The most samples `auto` may place (default: what half the available memory holds at
+    /// 600 bytes per sample, at most 33554432).
     #[arg(long, value_name = "N")]
     pub max_samples: Option<u64>,
     /// Seed of the sample placement.

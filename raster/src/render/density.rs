@@ -162,7 +162,9 @@ impl DensityPlan {
         }
         let f = &self.finest;
         let why = match self.origin {
-            DensityOrigin::Auto { max, .. } => format!("samples = \"auto\" capped by max_samples = {max}"),
+            DensityOrigin::Auto { max, .. } => {
+                format!("samples = \"auto\" capped by max_samples = {max}")
+            }
             DensityOrigin::Count => format!("samples = {}", self.count),
             DensityOrigin::Spacing(s) => format!("spacing = {}", Sig(s)),
             DensityOrigin::Baked => format!("a baked set of {} samples", self.count),
@@ -180,9 +182,9 @@ impl DensityPlan {
                 let alpha = smoothing * (self.area / f64::from(self.count.max(1))).sqrt() as f32;
                 format!(
                     "{name} will render hard, stair-stepped shadow edges (its smoothing radius \
-                     α = {} is {:.1}× ℓ_d)",
+                     α = {} is {}× ℓ_d)",
                     Sig(alpha),
-                    alpha / f.ell_d
+                    Sig(alpha / f.ell_d)
                 )
             }
         };
@@ -203,10 +205,11 @@ impl DensityPlan {
             )
         };
         Some(format!(
-            "object '{}': irradiance samples {} apart ({why}) are {ratio:.1}× its smallest \
+            "object '{}': irradiance samples {} apart ({why}) are {}× its smallest \
              diffuse mean free path ℓ_d = {} ({} channel of material '{}'): {effect}; {fix}",
             f.object_name,
             Sig(self.spacing()),
+            Sig(ratio),
             Sig(f.ell_d),
             CHANNELS[f.channel],
             f.material,
@@ -335,10 +338,7 @@ pub fn plan(
     };
     let area = translucent_area(prep);
     let (origin, count) = match (baked, settings.samples) {
-        (Some(n), _) => (
-            DensityOrigin::Baked,
-            u32::try_from(n).unwrap_or(u32::MAX),
-        ),
+        (Some(n), _) => (DensityOrigin::Baked, u32::try_from(n).unwrap_or(u32::MAX)),
         (None, SampleRequest::Auto) => {
             let max = settings.max_samples.unwrap_or_else(default_max_samples);
             let (count, capped) = auto_count(area, f64::from(finest.ell_d), max);
@@ -381,8 +381,14 @@ mod tests {
             assert_eq!(n, (area / (HEX * s * s)).ceil() as u64);
             // The spacing of N samples is at most ℓ_d/4, and one sample fewer would exceed it.
             let tol = 1.0 + 1e-6;
-            assert!(f64::from(hex_spacing(area, n as u32)) <= s * tol, "{area} {ell}");
-            assert!(f64::from(hex_spacing(area, n as u32 - 1)) * tol > s, "{area} {ell}");
+            assert!(
+                f64::from(hex_spacing(area, n as u32)) <= s * tol,
+                "{area} {ell}"
+            );
+            assert!(
+                f64::from(hex_spacing(area, n as u32 - 1)) * tol > s,
+                "{area} {ell}"
+            );
         }
         assert_eq!(resolving_count(1.0, 0.0), u64::MAX);
     }
@@ -440,19 +446,63 @@ mod tests {
         // Marble at 10 mm per unit: ℓ_d = 1/√(3 σ_a (σ_a + σ_s′)) = 3.95 mm in blue.
         let (sa, ss) = (0.0071_f64, 3.00_f64);
         let ell = 0.1 / (3.0 * sa * (sa + ss)).sqrt();
-        assert_eq!((p.finest.channel, p.finest.object_name.as_str()), (2, "bunny"));
-        assert!((f64::from(p.finest.ell_d) / ell - 1.0).abs() < 1e-4, "{p:?}");
+        assert_eq!(
+            (p.finest.channel, p.finest.object_name.as_str()),
+            (2, "bunny")
+        );
+        assert!(
+            (f64::from(p.finest.ell_d) / ell - 1.0).abs() < 1e-4,
+            "{p:?}"
+        );
         assert!((p.area - 218.69).abs() < 0.01, "{}", p.area);
-        assert_eq!(p.origin, DensityOrigin::Auto { max: 1 << 25, capped: false });
-        assert_eq!(u64::from(p.count), resolving_count(p.area, f64::from(p.finest.ell_d)));
+        assert_eq!(
+            p.origin,
+            DensityOrigin::Auto {
+                max: 1 << 25,
+                capped: false
+            }
+        );
+        assert_eq!(
+            u64::from(p.count),
+            resolving_count(p.area, f64::from(p.finest.ell_d))
+        );
         assert_eq!(p.count, 25_879);
         assert!(p.count >= 23_000);
         assert_eq!(p.describe(), "auto: spacing 0.0988 = 0.25 ℓ_d");
         assert_eq!(p.warning(SssMethod::Hierarchical, 1.5), None);
         // The shipped scene keeps the talk's count.
         let shipped = plan_of(&default_scene());
-        assert_eq!((shipped.origin, shipped.count), (DensityOrigin::Count, 23_000));
+        assert_eq!(
+            (shipped.origin, shipped.count),
+            (DensityOrigin::Count, 23_000)
+        );
         assert_eq!(shipped.describe(), "given: spacing 0.105 = 0.27 ℓ_d");
+    }
+
+    #[test]
+    fn the_shipped_scenes_keep_their_counts_and_would_get_these_automatically() {
+        for (file, shipped, auto) in [
+            ("sphere-shadow.toml", 23_000, MIN_AUTO_SAMPLES),
+            ("textured-mfp.toml", 40_000, 576_149),
+        ] {
+            let path = format!("{}/../scenes/{file}", env!("CARGO_MANIFEST_DIR"));
+            let mut scene = crate::scene::load_scene(std::path::Path::new(&path)).unwrap();
+            let p = plan_of(&scene);
+            assert_eq!(
+                (p.origin, p.count),
+                (DensityOrigin::Count, shipped),
+                "{file}"
+            );
+            // The shipped counts resolve ℓ_d for their method: no warning.
+            assert_eq!(
+                p.warning(scene.render.method, scene.render.smoothing),
+                None,
+                "{file}"
+            );
+            scene.render.samples = SampleRequest::Auto;
+            scene.render.max_samples = Some(1 << 25);
+            assert_eq!(plan_of(&scene).count, auto, "{file}");
+        }
     }
 
     /// A scene of translucent spheres: `(name, radius, material TOML)` each.
@@ -523,16 +573,19 @@ mod tests {
         let split = p.warning(SssMethod::EdgeAware, 1.5).unwrap();
         assert_eq!(
             split,
-            "object 'head': irradiance samples 0.107 apart (samples = 23000) are 3.9× its \
+            "object 'head': irradiance samples 0.107 apart (samples = 23000) are 3.91× its \
              smallest diffuse mean free path ℓ_d = 0.0273 (blue channel of material 'skin'): \
              edge-aware will render hard, stair-stepped shadow edges (its smoothing radius α = \
-             0.149 is 5.5× ℓ_d); about 5627169 samples (spacing 0.00683 = ℓ_d/4) would resolve \
+             0.149 is 5.46× ℓ_d); about 5627169 samples (spacing 0.00683 = ℓ_d/4) would resolve \
              it (samples = \"auto\" / --samples auto gives that)"
         );
         let lg = p.warning(SssMethod::LocalGlobal, 1.5).unwrap();
         assert!(lg.contains("local-global will render hard, stair-stepped shadow edges"));
         let h = p.warning(SssMethod::Hierarchical, 1.5).unwrap();
-        assert!(h.contains("hierarchical will show blotches (bright spots at the samples"), "{h}");
+        assert!(
+            h.contains("hierarchical will show blotches (bright spots at the samples"),
+            "{h}"
+        );
         // Far beyond ℓ_d: black.
         let sparse = plan_with(DensityOrigin::Count, 2_000, 0.0273);
         assert!(sparse.ratio() > BLACK_SPACING);
@@ -541,9 +594,19 @@ mod tests {
             assert!(w.contains("will render the object almost black"), "{w}");
         }
         // Capped auto points at the cap.
-        let capped = plan_with(DensityOrigin::Auto { max: 100_000, capped: true }, 100_000, 0.0273);
+        let capped = plan_with(
+            DensityOrigin::Auto {
+                max: 100_000,
+                capped: true,
+            },
+            100_000,
+            0.0273,
+        );
         let w = capped.warning(SssMethod::EdgeAware, 1.5).unwrap();
-        assert!(w.contains("(samples = \"auto\" capped by max_samples = 100000)"), "{w}");
+        assert!(
+            w.contains("(samples = \"auto\" capped by max_samples = 100000)"),
+            "{w}"
+        );
         assert!(w.contains("raise max_samples / --max-samples"), "{w}");
         assert_eq!(
             capped.describe(),
@@ -551,7 +614,11 @@ mod tests {
         );
         // Spacings and baked sets.
         let s = plan_with(DensityOrigin::Spacing(0.05), 104_830, 0.0273);
-        assert!(s.warning(SssMethod::EdgeAware, 1.5).unwrap().contains("(spacing = 0.0500)"));
+        assert!(
+            s.warning(SssMethod::EdgeAware, 1.5)
+                .unwrap()
+                .contains("(spacing = 0.0500)")
+        );
         let b = plan_with(DensityOrigin::Baked, 23_000, 0.0273);
         let w = b.warning(SssMethod::EdgeAware, 1.5).unwrap();
         assert!(w.contains("(a baked set of 23000 samples)"), "{w}");
@@ -575,7 +642,10 @@ mod tests {
     #[test]
     fn a_render_reports_its_plan_and_warning() {
         let skin = "preset = 'skin1'\nmm_per_unit = 25";
-        let scene = spheres(&[("head", 4.0, skin)], "samples = 2000\nmethod = 'hierarchical'");
+        let scene = spheres(
+            &[("head", 4.0, skin)],
+            "samples = 2000\nmethod = 'hierarchical'",
+        );
         let r = render(&scene, &RenderOptions::default()).unwrap();
         let plan = r.stats.density.as_ref().unwrap();
         assert_eq!(plan.count as usize, r.stats.samples);
@@ -586,7 +656,13 @@ mod tests {
         let scene = spheres(&[("head", 4.0, skin)], "max_samples = 5000");
         let r = render(&scene, &RenderOptions::default()).unwrap();
         let plan = r.stats.density.as_ref().unwrap();
-        assert_eq!(plan.origin, DensityOrigin::Auto { max: 5000, capped: true });
+        assert_eq!(
+            plan.origin,
+            DensityOrigin::Auto {
+                max: 5000,
+                capped: true
+            }
+        );
         assert_eq!(r.stats.samples, 5000);
         assert!(r.stats.warning.is_some());
     }
@@ -607,9 +683,10 @@ mod tests {
         });
         let m = m.expect("a translucent material");
         let crate::scene::Medium::Reflectance {
-            distance: crate::scene::Distance::MeanFreePath(crate::scene::ScalarParam::Texture {
-                texture, ..
-            }),
+            distance:
+                crate::scene::Distance::MeanFreePath(crate::scene::ScalarParam::Texture {
+                    texture, ..
+                }),
             ..
         } = &m.medium
         else {
@@ -630,7 +707,10 @@ mod tests {
             assert!((bound[c] / brute[c] - 1.0).abs() < 1e-4, "{bound} {brute}");
         }
         // ℓ_u = 0.005 at the ramp's dark end, K_d 0.75 in blue.
-        assert!(bound.z < bound.x && (0.04..0.05).contains(&bound.z), "{bound}");
+        assert!(
+            bound.z < bound.x && (0.04..0.05).contains(&bound.z),
+            "{bound}"
+        );
         let p = plan(&prep, &scene.render, None).unwrap().unwrap();
         assert_eq!(p.finest.ell_d, bound.min_element());
     }

@@ -140,7 +140,11 @@ fn render_and_output_values() {
 
 #[test]
 fn sample_counts_parse() {
-    let render = |line: &str| load(&append(&format!("[render]\n{line}\n"))).unwrap().render;
+    let render = |line: &str| {
+        load(&append(&format!("[render]\n{line}\n")))
+            .unwrap()
+            .render
+    };
     // The default, absent or spelled out.
     assert_eq!(load(BASE).unwrap().render.samples, SampleRequest::Auto);
     assert_eq!(render("samples = 'auto'").samples, SampleRequest::Auto);
