@@ -25,8 +25,8 @@
 //!
 //! Whatever chose the count (auto with its cap, an explicit count or spacing, a baked set), a
 //! spacing above [`WARN_SPACING`] · ℓ_d,min gets one warning ([`DensityPlan::warning`]): the
-//! unsplit methods then show blotches around the samples (and a black image once the spacing
-//! is many ℓ_d), the split methods hard, stair-stepped shadow edges.
+//! unsplit methods then show blotches around the samples (and a mostly black image from
+//! [`BLACK_SPACING`] = 100 ℓ_d on), the split methods hard, stair-stepped shadow edges.
 
 use super::RenderError;
 use super::prepare::Prepared;
@@ -41,9 +41,11 @@ pub const AUTO_SPACING: f32 = 0.25;
 /// automatic spacing, 1/16 of its count).
 pub const WARN_SPACING: f32 = 1.0;
 
-/// Above this multiple of ℓ_d,min the unsplit methods' image is mostly black: a point midway
-/// between samples is about 0.58 spacings from the nearest, where e^(−r/ℓ_d) < 1%.
-pub const BLACK_SPACING: f32 = 8.0;
+/// At this multiple of a channel's ℓ_d (and above) the unsplit methods lose most of that
+/// channel's light: the profile falls off as e^(−r/ℓ_d), so most shading points get almost
+/// nothing even from the nearest sample and only spots at the samples stay lit (the mean
+/// relative error of the exhaustive sum passes 50% between 40× and 110× ℓ_d; below, blotches).
+pub const BLACK_SPACING: f32 = 100.0;
 
 /// The automatic count never goes below this, so that the samples still follow the surface's
 /// shape when ℓ_d is large against the objects.
@@ -93,6 +95,8 @@ pub struct Finest {
     pub channel: usize,
     /// ℓ_d = 1/σ_tr there (scene units).
     pub ell_d: f32,
+    /// The object's smallest ℓ_d in each channel (`ell_d` is the least of them).
+    pub channels: [f32; 3],
 }
 
 /// The sample count of one render and what it resolves.
@@ -171,10 +175,24 @@ impl DensityPlan {
         };
         let name = crate::render::core_method(method).name();
         let effect = match method {
-            SssMethod::Hierarchical | SssMethod::Exhaustive if ratio >= BLACK_SPACING => format!(
-                "{name} will render the object almost black (the profile falls off as \
-                 e^(−r/ℓ_d), and most points are several ℓ_d from every sample)"
-            ),
+            SssMethod::Hierarchical | SssMethod::Exhaustive if ratio >= BLACK_SPACING => {
+                let spacing = self.spacing();
+                let lost: Vec<&str> = (0..3)
+                    .filter(|&c| spacing >= BLACK_SPACING * f.channels[c])
+                    .map(|c| CHANNELS[c])
+                    .collect();
+                let why = "the profile falls off as e^(−r/ℓ_d), and most points are many ℓ_d \
+                           from every sample";
+                if lost.len() == 3 {
+                    format!("{name} will render the object mostly black ({why})")
+                } else {
+                    format!(
+                        "{name} will lose most of the object's {} light ({why}) and show \
+                         blotches",
+                        lost.join(" and ")
+                    )
+                }
+            }
             SssMethod::Hierarchical | SssMethod::Exhaustive => format!(
                 "{name} will show blotches (bright spots at the samples, dark between them)"
             ),
@@ -305,6 +323,7 @@ pub fn finest(prep: &Prepared) -> Option<Finest> {
                 material: shader.name.clone(),
                 channel,
                 ell_d: ell[channel],
+                channels: ell.to_array(),
             });
         }
     }
@@ -551,6 +570,7 @@ mod tests {
         assert_eq!(alone.finest.ell_d, p.finest.ell_d);
     }
 
+    /// A plan with skin1's ℓ_d ratios across the channels (red 5.4×, green 2× the blue).
     fn plan_with(origin: DensityOrigin, count: u32, ell_d: f32) -> DensityPlan {
         DensityPlan {
             origin,
@@ -562,6 +582,7 @@ mod tests {
                 material: "skin".into(),
                 channel: 2,
                 ell_d,
+                channels: [5.4 * ell_d, 2.0 * ell_d, ell_d],
             },
         }
     }
@@ -586,13 +607,30 @@ mod tests {
             h.contains("hierarchical will show blotches (bright spots at the samples"),
             "{h}"
         );
-        // Far beyond ℓ_d: black.
-        let sparse = plan_with(DensityOrigin::Count, 2_000, 0.0273);
-        assert!(sparse.ratio() > BLACK_SPACING);
+        // Far beyond ℓ_d in blue and green, not in red: those two channels' light is lost.
+        let sparse = plan_with(DensityOrigin::Count, 23_000, 0.0005);
+        assert!(sparse.ratio() > 2.0 * BLACK_SPACING);
+        assert!(sparse.spacing() < 5.4 * 0.0005 * BLACK_SPACING);
         for m in [SssMethod::Hierarchical, SssMethod::Exhaustive] {
             let w = sparse.warning(m, 1.5).unwrap();
-            assert!(w.contains("will render the object almost black"), "{w}");
+            let lost = "will lose most of the object's green and blue light (the profile";
+            assert!(w.contains(lost), "{w}");
+            assert!(
+                w.ends_with("(check the scene's units and mm_per_unit)"),
+                "{w}"
+            );
         }
+        // Beyond in every channel: black.
+        let black = plan_with(DensityOrigin::Count, 23_000, 0.0001);
+        let w = black.warning(SssMethod::Exhaustive, 1.5).unwrap();
+        assert!(
+            w.contains("exhaustive will render the object mostly black"),
+            "{w}"
+        );
+        // Just below the black threshold: blotches.
+        let blotchy = plan_with(DensityOrigin::Count, 23_000, 0.107 / 99.0);
+        let w = blotchy.warning(SssMethod::Hierarchical, 1.5).unwrap();
+        assert!(w.contains("hierarchical will show blotches"), "{w}");
         // Capped auto points at the cap.
         let capped = plan_with(
             DensityOrigin::Auto {
@@ -644,14 +682,14 @@ mod tests {
         let skin = "preset = 'skin1'\nmm_per_unit = 25";
         let scene = spheres(
             &[("head", 4.0, skin)],
-            "samples = 2000\nmethod = 'hierarchical'",
+            "samples = 200\nmethod = 'hierarchical'",
         );
         let r = render(&scene, &RenderOptions::default()).unwrap();
         let plan = r.stats.density.as_ref().unwrap();
         assert_eq!(plan.count as usize, r.stats.samples);
         let w = r.stats.warning.as_deref().unwrap();
         assert!(w.starts_with("object 'head': irradiance samples"), "{w}");
-        assert!(w.contains("almost black"), "{w}");
+        assert!(w.contains("hierarchical will show blotches"), "{w}");
         // Auto under a cap: the render places the capped count and says so.
         let scene = spheres(&[("head", 4.0, skin)], "max_samples = 5000");
         let r = render(&scene, &RenderOptions::default()).unwrap();
