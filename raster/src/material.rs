@@ -150,14 +150,44 @@ pub struct PointMaterial {
 fn scalar_at(p: &ScalarParam, uv: Vec2) -> Vec3 {
     match p {
         ScalarParam::Constant(v) => *v,
-        ScalarParam::Texture { texture, min, max } => {
-            let t = texture.sample(uv).clamp(Vec3::ZERO, Vec3::ONE);
+        ScalarParam::Texture { texture, .. } => scalar_at_value(p, texture.sample(uv)),
+    }
+}
+
+/// A distance parameter at texture value `t` (clamped to [0, 1]).
+fn scalar_at_value(p: &ScalarParam, t: Vec3) -> Vec3 {
+    match p {
+        ScalarParam::Constant(v) => *v,
+        ScalarParam::Texture { min, max, .. } => {
+            let t = t.clamp(Vec3::ZERO, Vec3::ONE);
             let ratio = (max / min).ln();
             Vec3::new(
                 min * (ratio * t.x).exp(),
                 min * (ratio * t.y).exp(),
                 min * (ratio * t.z).exp(),
             )
+        }
+    }
+}
+
+/// The per-channel smallest and largest texel of a texture.
+fn texel_range(t: &Texture) -> (Vec3, Vec3) {
+    t.texels
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+/// The smallest value of a distance parameter over the surface, per channel.
+fn smallest_scalar(p: &ScalarParam) -> Vec3 {
+    match p {
+        ScalarParam::Constant(v) => *v,
+        ScalarParam::Texture { texture, .. } => {
+            let (lo, hi) = texel_range(texture);
+            // min·(max/min)^t is monotone in t: the extreme is at one end of the texel range.
+            let at = |t: Vec3| scalar_at_value(p, t);
+            at(lo).min(at(hi))
         }
     }
 }
@@ -182,6 +212,41 @@ impl TranslucentShader {
     pub fn base_profile(&self) -> &Profile {
         match &self.params {
             Params::Fixed(p) | Params::Reflectance { base: p, .. } => p,
+        }
+    }
+
+    /// The smallest diffuse mean free path ℓ_d = 1/σ_tr anywhere on the surface, per channel:
+    /// what the irradiance sample spacing must resolve. Textures are bilinear, so their
+    /// extremes are texels: ℓ_u (or ℓ_d) is taken at the texel that makes it smallest, and a
+    /// textured K_d at its smallest texel (ℓ_d = ℓ_u / √(3(1 − α′)) grows with α′, which grows
+    /// with K_d). With both textured the two extremes need not meet at one point, so the value is
+    /// a lower bound there; otherwise it is the minimum.
+    pub fn smallest_diffuse_mean_free_path(&self) -> Vec3 {
+        let (kd, distance) = match &self.params {
+            Params::Fixed(p) => return p.diffuse_mean_free_path(),
+            Params::Reflectance { kd, distance, .. } => (kd, distance),
+        };
+        let albedo: [f64; 3] = match kd {
+            KdSource::Constant(a) => *a,
+            KdSource::Texture(t, inverter) => {
+                let lo = texel_range(t)
+                    .0
+                    .clamp(Vec3::splat(0.001), Vec3::splat(0.999));
+                [
+                    inverter.albedo(lo.x),
+                    inverter.albedo(lo.y),
+                    inverter.albedo(lo.z),
+                ]
+            }
+        };
+        match distance {
+            Distance::DiffuseMeanFreePath(p) => smallest_scalar(p),
+            Distance::MeanFreePath(p) => {
+                let ell_u = smallest_scalar(p);
+                Vec3::from_array(std::array::from_fn(|c| {
+                    (f64::from(ell_u[c]) / (3.0 * (1.0 - albedo[c])).sqrt()) as f32
+                }))
+            }
         }
     }
 

@@ -50,7 +50,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     let small = |mut s: Scene, size: u32, samples: u32| {
         s.camera.width = size;
         s.camera.height = size;
-        s.render.samples = SampleDensity::Count(samples);
+        s.render.samples = SampleDensity::Count(samples).into();
         s.render.aa = 2;
         s.render.threads = Some(2);
         s

@@ -202,7 +202,7 @@ pub fn configure(base: &Scene, setting: MethodSetting, samples: u32, seed: u64) 
     let mut scene = base.clone();
     scene.render.method = setting.method;
     scene.render.epsilon = setting.epsilon;
-    scene.render.samples = SampleDensity::Count(samples);
+    scene.render.samples = SampleDensity::Count(samples).into();
     scene.render.seed = seed;
     scene
 }

@@ -5,12 +5,13 @@ use std::path::Path;
 
 use lucent_core::{Profile, presets};
 
-use super::{BakeArgs, BenchArgs, MethodArg, RenderArgs};
+use super::{BakeArgs, BenchArgs, MethodArg, RenderArgs, SamplesArg};
 use crate::bench::{self, BenchConfig, BenchScene};
 use crate::output::{write_exr, write_png};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
-    MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, Scene, SssMethod, default_scene, load_scene,
+    MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene, SssMethod,
+    default_scene, load_scene,
 };
 
 /// Loads the scene named on the command line, or the built-in default.
@@ -29,15 +30,24 @@ fn check(ok: bool, flag: &str, value: impl std::fmt::Display, range: &str) -> Re
     }
 }
 
-fn density(samples: Option<u32>, spacing: Option<f32>, scene: &mut Scene) -> Result<(), String> {
-    if let Some(n) = samples {
-        check(
-            n >= 1 && n as i64 <= MAX_SAMPLES,
-            "--samples",
-            n,
-            &format!("between 1 and {MAX_SAMPLES}"),
-        )?;
-        scene.render.samples = SampleDensity::Count(n);
+fn density(
+    samples: Option<SamplesArg>,
+    spacing: Option<f32>,
+    max_samples: Option<u64>,
+    scene: &mut Scene,
+) -> Result<(), String> {
+    match samples {
+        Some(SamplesArg::Auto) => scene.render.samples = SampleRequest::Auto,
+        Some(SamplesArg::Count(n)) => {
+            check(
+                n >= 1 && n <= MAX_SAMPLES as u64,
+                "--samples",
+                n,
+                &format!("between 1 and {MAX_SAMPLES}, or auto"),
+            )?;
+            scene.render.samples = SampleDensity::Count(n as u32).into();
+        }
+        None => {}
     }
     if let Some(s) = spacing {
         check(
@@ -46,7 +56,27 @@ fn density(samples: Option<u32>, spacing: Option<f32>, scene: &mut Scene) -> Res
             s,
             "a positive distance",
         )?;
-        scene.render.samples = SampleDensity::Spacing(s);
+        scene.render.samples = SampleDensity::Spacing(s).into();
+    }
+    if let Some(m) = max_samples {
+        check(
+            m >= 1 && m <= MAX_SAMPLES as u64,
+            "--max-samples",
+            m,
+            &format!("between 1 and {MAX_SAMPLES}"),
+        )?;
+        let given = match scene.render.samples {
+            SampleRequest::Auto => None,
+            SampleRequest::Density(SampleDensity::Count(n)) => Some(format!("samples = {n}")),
+            SampleRequest::Density(SampleDensity::Spacing(s)) => Some(format!("spacing = {s}")),
+        };
+        if let Some(given) = given {
+            return Err(format!(
+                "--max-samples {m}: caps the automatic count only, but the render asks for \
+                 {given} (add --samples auto)"
+            ));
+        }
+        scene.render.max_samples = Some(m as u32);
     }
     Ok(())
 }
@@ -74,7 +104,7 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
             MethodArg::Exhaustive => SssMethod::Exhaustive,
         };
     }
-    density(args.samples, args.spacing, scene)?;
+    density(args.samples, args.spacing, args.max_samples, scene)?;
     threads(args.threads, scene)?;
     for (flag, value, slot) in [
         ("--width", args.width, &mut scene.camera.width),
@@ -195,6 +225,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
     let options = RenderOptions {
         baked: baked.as_deref(),
         progress: !args.quiet,
+        warn: true,
         ..RenderOptions::default()
     };
     let result = render::render(&scene, &options).map_err(|e| e.to_string())?;
@@ -213,10 +244,13 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         let s = &result.stats;
         let t = &s.timings;
         println!(
-            "lucent: {}×{}, {} samples, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries), total {}, cache {:.1} MB, {} threads → {}",
+            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries), total {}, cache {:.1} MB, {} threads → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
+            s.density
+                .as_ref()
+                .map_or(String::new(), |d| format!(" ({})", d.describe())),
             render::core_method(scene.render.method).name(),
             seconds(t.sampling),
             seconds(t.irradiance),
@@ -236,13 +270,14 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
 /// `lucent bake`.
 pub fn bake(args: &BakeArgs) -> Result<(), String> {
     let mut scene = load(args.scene.as_deref())?;
-    density(args.samples, args.spacing, &mut scene)?;
+    density(args.samples, args.spacing, args.max_samples, &mut scene)?;
     threads(args.threads, &mut scene)?;
     if let Some(seed) = args.seed {
         scene.render.seed = seed;
     }
     let start = std::time::Instant::now();
-    let sets = render::bake(&scene, !args.quiet).map_err(|e| e.to_string())?;
+    let (sets, plan) =
+        render::bake_planned(&scene, !args.quiet, true).map_err(|e| e.to_string())?;
     let names: Vec<String> = scene.objects.iter().map(|o| o.name.clone()).collect();
     let source = scene
         .source
@@ -257,8 +292,9 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
     write_baked(&args.output, &sets, &names, &provenance).map_err(|e| e.to_string())?;
     if !args.quiet {
         let n: usize = sets.iter().map(|s| s.len()).sum();
+        let how = plan.map_or(String::new(), |d| format!(" ({})", d.describe()));
         println!(
-            "lucent bake: {n} samples on {} objects in {} → {}",
+            "lucent bake: {n} samples{how} on {} objects in {} → {}",
             sets.len(),
             seconds(start.elapsed()),
             args.output.display()

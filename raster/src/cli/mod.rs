@@ -78,12 +78,18 @@ pub struct RenderArgs {
     /// Subsurface method.
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
-    /// Number of irradiance samples over all translucent surfaces.
-    #[arg(long, value_name = "N", conflicts_with = "spacing")]
-    pub samples: Option<u32>,
+    /// Irradiance samples over all translucent surfaces: `auto` (the default, unless the scene
+    /// gives a count) spaces them a quarter of the smallest diffuse mean free path ℓ_d of the
+    /// translucent materials apart, up to --max-samples; or a count N.
+    #[arg(long, value_name = "N|auto", value_parser = parse_samples, conflicts_with = "spacing")]
+    pub samples: Option<SamplesArg>,
     /// Irradiance sample spacing in scene units (instead of a count).
     #[arg(long, value_name = "DISTANCE")]
     pub spacing: Option<f32>,
+    /// The most samples `auto` may place (default: what half the available memory holds at
+    /// 600 bytes per sample, at most 33554432).
+    #[arg(long, value_name = "N")]
+    pub max_samples: Option<u64>,
     /// Image width in pixels.
     #[arg(long, value_name = "W")]
     pub width: Option<u32>,
@@ -111,9 +117,27 @@ pub struct RenderArgs {
     /// Load irradiance samples baked by `lucent bake` instead of placing and lighting new ones.
     #[arg(long, value_name = "FILE.ply")]
     pub samples_from: Option<PathBuf>,
-    /// Print nothing but errors.
+    /// Print nothing but errors and warnings.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// `--samples`: `auto` or a count (its range is checked with the scene, exit status 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplesArg {
+    /// The automatic count.
+    Auto,
+    /// This many.
+    Count(u64),
+}
+
+fn parse_samples(text: &str) -> Result<SamplesArg, String> {
+    if text == crate::scene::AUTO {
+        return Ok(SamplesArg::Auto);
+    }
+    text.parse()
+        .map(SamplesArg::Count)
+        .map_err(|_| "expected a sample count (a positive integer) or `auto`".to_string())
 }
 
 /// Options of `bake`.
@@ -124,19 +148,25 @@ pub struct BakeArgs {
     /// Where to write the samples (binary PLY).
     #[arg(short, long, value_name = "OUT.ply", default_value = "samples.ply")]
     pub output: PathBuf,
-    /// Number of irradiance samples.
-    #[arg(long, value_name = "N", conflicts_with = "spacing")]
-    pub samples: Option<u32>,
-    /// Irradiance sample spacing in scene units.
+    /// Irradiance samples over all translucent surfaces: `auto` (the default, unless the scene
+    /// gives a count) spaces them a quarter of the smallest diffuse mean free path ℓ_d of the
+    /// translucent materials apart, up to --max-samples; or a count N.
+    #[arg(long, value_name = "N|auto", value_parser = parse_samples, conflicts_with = "spacing")]
+    pub samples: Option<SamplesArg>,
+    /// Irradiance sample spacing in scene units (instead of a count).
     #[arg(long, value_name = "DISTANCE")]
     pub spacing: Option<f32>,
+    /// The most samples `auto` may place (default: what half the available memory holds at
+    /// 600 bytes per sample, at most 33554432).
+    #[arg(long, value_name = "N")]
+    pub max_samples: Option<u64>,
     /// Seed of the sample placement.
     #[arg(long)]
     pub seed: Option<u64>,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
-    /// Print nothing but errors.
+    /// Print nothing but errors and warnings.
     #[arg(short, long)]
     pub quiet: bool,
 }

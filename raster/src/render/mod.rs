@@ -13,6 +13,7 @@
 
 mod baked;
 mod convexity;
+pub mod density;
 mod irradiance;
 mod prepare;
 mod shading;
@@ -27,6 +28,7 @@ use rayon::prelude::*;
 
 pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
 pub use convexity::cannot_shadow_itself;
+pub use density::{DensityOrigin, DensityPlan};
 pub use irradiance::ObjectSamples;
 pub use prepare::{Prepared, can_occlude};
 pub use shading::{ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounters, ShadingStats};
@@ -81,6 +83,9 @@ pub struct RenderOptions<'a> {
     pub baked: Option<&'a [ObjectSamples]>,
     /// Show progress bars on stderr (only when it is a terminal).
     pub progress: bool,
+    /// Print the under-resolution warning ([`DensityPlan::warning`]) on stderr as soon as the
+    /// sample count is known (it is in [`RenderStats::warning`] either way).
+    pub warn: bool,
     /// Count traversal statistics and time the translucent shading points (slightly slower).
     pub collect_stats: bool,
     /// Compute K by quadrature at every shading point instead of the power-of-two table.
@@ -115,6 +120,10 @@ pub struct Timings {
 pub struct RenderStats {
     /// Irradiance samples over all translucent objects.
     pub samples: usize,
+    /// How the sample count was chosen (`None` without translucent objects).
+    pub density: Option<DensityPlan>,
+    /// The under-resolution warning, if the samples are too far apart for the material.
+    pub warning: Option<String>,
     /// Bytes held by the irradiance caches.
     pub cache_bytes: usize,
     /// Surfaces shaded (one per pixel and visible object).
@@ -203,17 +212,41 @@ fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, RenderError>
 
 /// Places and lights the irradiance samples of a scene (what `lucent bake` writes).
 pub fn bake(scene: &Scene, progress: bool) -> Result<Vec<ObjectSamples>, RenderError> {
+    bake_planned(scene, progress, false).map(|(sets, _)| sets)
+}
+
+/// [`bake`], also returning how the count was chosen; `warn` prints the under-resolution
+/// warning (for the scene's method) on stderr.
+pub fn bake_planned(
+    scene: &Scene,
+    progress: bool,
+    warn: bool,
+) -> Result<(Vec<ObjectSamples>, Option<DensityPlan>), RenderError> {
     let pool = thread_pool(scene.render.threads)?;
     pool.install(|| {
         let prep = Prepared::new(scene)?;
+        let plan = density::plan(&prep, &scene.render, None)?;
+        warn_once(warn, plan.as_ref(), scene);
         let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
-        let mut sets = irradiance::place_samples(&prep, scene.render.samples, scene.render.seed)?;
+        let mut sets = match &plan {
+            Some(plan) => irradiance::place_samples(&prep, plan.density(), scene.render.seed)?,
+            None => Vec::new(),
+        };
         let total: usize = sets.iter().map(|s| s.len()).sum();
         let b = bar(progress, total as u64, "irradiance");
         irradiance::light_samples(&prep, &mut sets, &lighting, &b);
         b.finish_and_clear();
-        Ok(sets)
+        Ok((sets, plan))
     })
+}
+
+/// The under-resolution warning of a plan; printed on stderr when `print`.
+fn warn_once(print: bool, plan: Option<&DensityPlan>, scene: &Scene) -> Option<String> {
+    let warning = plan?.warning(scene.render.method, scene.render.smoothing)?;
+    if print {
+        eprintln!("warning: {warning}");
+    }
+    Some(warning)
 }
 
 /// Renders a scene.
@@ -239,14 +272,20 @@ fn render_in_pool(
     timings.prepare = t.elapsed();
 
     // Irradiance samples: placed and lit here, or taken from a baked set.
-    let sets = match options.baked {
-        Some(baked) => {
+    let baked_count = options
+        .baked
+        .map(|b| b.iter().map(ObjectSamples::len).sum());
+    let plan = density::plan(&prep, settings, baked_count)?;
+    let warning = warn_once(options.warn, plan.as_ref(), scene);
+    let sets = match (options.baked, &plan) {
+        (Some(baked), _) => {
             baked::check_fits(&prep, baked)?;
             baked.to_vec()
         }
-        None => {
+        (None, None) => Vec::new(),
+        (None, Some(plan)) => {
             let t = Instant::now();
-            let mut sets = irradiance::place_samples(&prep, settings.samples, settings.seed)?;
+            let mut sets = irradiance::place_samples(&prep, plan.density(), settings.seed)?;
             timings.sampling = t.elapsed();
             let t = Instant::now();
             let total: usize = sets.iter().map(|s| s.len()).sum();
@@ -398,6 +437,8 @@ fn render_in_pool(
         pixels,
         stats: RenderStats {
             samples: sets.iter().map(|s| s.len()).sum(),
+            density: plan,
+            warning,
             cache_bytes,
             shading_points,
             queries,

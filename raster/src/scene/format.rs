@@ -117,7 +117,8 @@ pub(crate) struct RawLight {
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawRender {
     pub method: Option<Str>,
-    pub samples: Option<Int>,
+    pub samples: Option<Spanned<RawSamples>>,
+    pub max_samples: Option<Int>,
     pub spacing: Option<Num>,
     pub epsilon: Option<Num>,
     pub smoothing: Option<Num>,
@@ -127,6 +128,44 @@ pub(crate) struct RawRender {
     pub exposure: Option<Num>,
     pub threads: Option<Int>,
     pub seed: Option<Int>,
+}
+
+/// `render.samples`: an integer, or a word (only `"auto"` is valid; checked when building, so
+/// that a wrong word gets a located message naming the key).
+#[derive(Debug)]
+pub(crate) enum RawSamples {
+    /// An integer (any sign; the range is checked when building).
+    Count(i64),
+    /// A string.
+    Word(String),
+}
+
+impl<'de> Deserialize<'de> for RawSamples {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(SamplesVisitor)
+    }
+}
+
+struct SamplesVisitor;
+
+impl<'de> Visitor<'de> for SamplesVisitor {
+    type Value = RawSamples;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a sample count (an integer) or \"auto\"")
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<RawSamples, E> {
+        Ok(RawSamples::Count(v))
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<RawSamples, E> {
+        Ok(RawSamples::Count(i64::try_from(v).unwrap_or(i64::MAX)))
+    }
+
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawSamples, E> {
+        Ok(RawSamples::Word(v.to_string()))
+    }
 }
 
 /// `[output]`.

@@ -227,7 +227,7 @@ pub enum SssMethod {
     Exhaustive,
 }
 
-/// How densely to place irradiance samples.
+/// A concrete irradiance sample density: what the sample placement is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SampleDensity {
     /// About this many samples over all translucent surfaces.
@@ -236,13 +236,34 @@ pub enum SampleDensity {
     Spacing(f32),
 }
 
+/// How many irradiance samples a scene asks for (`render.samples`, `render.spacing`).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum SampleRequest {
+    /// `samples = "auto"` (the default): a spacing of a fixed fraction of the smallest diffuse
+    /// mean free path ℓ_d of the translucent materials, capped by
+    /// [`RenderSettings::max_samples`] (see `raster/src/render/density.rs`).
+    #[default]
+    Auto,
+    /// An explicit count or spacing.
+    Density(SampleDensity),
+}
+
+impl From<SampleDensity> for SampleRequest {
+    fn from(d: SampleDensity) -> Self {
+        SampleRequest::Density(d)
+    }
+}
+
 /// Render settings (the `[render]` table).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     /// Subsurface method.
     pub method: SssMethod,
-    /// Irradiance sample density.
-    pub samples: SampleDensity,
+    /// Irradiance sample density: automatic, or a count or spacing.
+    pub samples: SampleRequest,
+    /// The most samples `Auto` may place; `None` = sized to the machine's available memory
+    /// (`render::density::default_max_samples`). Explicit counts and spacings ignore it.
+    pub max_samples: Option<u32>,
     /// JB02 solid-angle threshold ε (aggregate a node when A/d² < ε).
     pub epsilon: f32,
     /// Smoothing radius factor k: α = k · √(mean sample area).
@@ -266,7 +287,8 @@ impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
             method: SssMethod::EdgeAware,
-            samples: SampleDensity::Count(23_000),
+            samples: SampleRequest::Auto,
+            max_samples: None,
             epsilon: 0.5,
             smoothing: 1.5,
             ell_min: None,

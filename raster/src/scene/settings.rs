@@ -7,8 +7,10 @@ use toml::Spanned;
 
 use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
-use super::format::{RawCamera, RawOutput, RawRender};
-use super::model::{ExrLayers, OutputSettings, RenderSettings, SampleDensity, SssMethod};
+use super::format::{RawCamera, RawOutput, RawRender, RawSamples};
+use super::model::{
+    ExrLayers, OutputSettings, RenderSettings, SampleDensity, SampleRequest, SssMethod,
+};
 use crate::camera::Camera;
 
 /// Default image width and height.
@@ -22,6 +24,9 @@ pub const MAX_PIXELS: i64 = 1 << 26;
 
 /// Largest number of irradiance samples a scene may ask for (directly or through `spacing`).
 pub const MAX_SAMPLES: i64 = 1 << 25;
+
+/// The word that asks for an automatic sample count (`samples = "auto"`, `--samples auto`).
+pub const AUTO: &str = "auto";
 
 /// Values accepted by `render.method`.
 pub const METHODS: [(&str, SssMethod); 4] = [
@@ -148,9 +153,7 @@ pub(crate) fn build_render(
                 "cannot be combined with `samples`: give a count or a spacing",
             ));
         }
-        (Some(n), None) => {
-            s.samples = SampleDensity::Count(c.int("render.samples", n, 1, MAX_SAMPLES)? as u32);
-        }
+        (Some(n), None) => s.samples = samples(c, n)?,
         (None, Some(d)) => {
             let spacing = c.positive("render.spacing", d)?;
             // Poisson-disk samples at least `spacing` apart cover at most one hexagon of area
@@ -167,9 +170,28 @@ pub(crate) fn build_render(
                     ),
                 ));
             }
-            s.samples = SampleDensity::Spacing(spacing);
+            s.samples = SampleDensity::Spacing(spacing).into();
         }
         (None, None) => {}
+    }
+    if let Some(m) = &r.max_samples {
+        if s.samples != SampleRequest::Auto {
+            let given = if r.samples.is_some() {
+                "samples"
+            } else {
+                "spacing"
+            };
+            return Err(c.at(
+                SceneErrorKind::Conflict,
+                "render.max_samples",
+                m,
+                format!(
+                    "caps the automatic count only (samples = \"auto\"), but the scene gives \
+                     `{given}`: remove one of the two"
+                ),
+            ));
+        }
+        s.max_samples = Some(c.int("render.max_samples", m, 1, MAX_SAMPLES)? as u32);
     }
     if let Some(v) = &r.epsilon {
         s.epsilon = c.non_negative("render.epsilon", v)?;
@@ -206,6 +228,26 @@ pub(crate) fn build_render(
         s.seed = c.int("render.seed", v, 0, i64::MAX)? as u64;
     }
     Ok(s)
+}
+
+/// `render.samples`: `"auto"` or a count in `1..=MAX_SAMPLES`.
+fn samples(c: &Check, n: &Spanned<RawSamples>) -> Checked<SampleRequest> {
+    match n.get_ref() {
+        RawSamples::Word(w) if w == AUTO => Ok(SampleRequest::Auto),
+        RawSamples::Word(w) => Err(c.range(
+            "render.samples",
+            n,
+            format!("`{w}` is not a sample count (expected an integer in 1..={MAX_SAMPLES} or \"{AUTO}\")"),
+        )),
+        RawSamples::Count(k) if (1..=MAX_SAMPLES).contains(k) => {
+            Ok(SampleDensity::Count(*k as u32).into())
+        }
+        RawSamples::Count(k) => Err(c.range(
+            "render.samples",
+            n,
+            format!("must be in 1..={MAX_SAMPLES} or \"{AUTO}\" (got {k})"),
+        )),
+    }
 }
 
 /// Builds the output settings. Without `png` and `exr`, the PNG goes to `<stem>.png`.

@@ -99,3 +99,111 @@ fn zero_and_huge_resolution_flags() {
         sb.fails(&render(extra), 1, needles);
     }
 }
+
+/// `--samples` and `--max-samples`: `auto` or a count; malformed values are usage errors
+/// (exit 2), out-of-range ones and a cap on an explicit count runtime errors (exit 1).
+#[test]
+fn sample_count_flags() {
+    let sb = Sandbox::new("flags-samples");
+    let usage: &[(&[&str], &[&str])] = &[
+        (
+            &["--samples", "lots"],
+            &["invalid value 'lots' for '--samples <N|auto>'", "or `auto`"],
+        ),
+        (&["--samples", "1.5"], &["invalid value '1.5'", "--samples"]),
+        (
+            &["--max-samples", "auto"],
+            &["invalid value 'auto'", "--max-samples"],
+        ),
+        (&["--max-samples", "-3"], &["unexpected argument '-3'"]),
+    ];
+    for (extra, needles) in usage {
+        sb.fails(&render(extra), 2, needles);
+    }
+    sb.fails(&["bake", "scene.toml", "--samples", "lots"], 2, &["'lots'"]);
+    let runtime: &[(&[&str], &[&str])] = &[
+        (
+            &["--samples", "33554433"],
+            &["--samples 33554433", "or auto"],
+        ),
+        (
+            &["--max-samples", "0"],
+            &["--max-samples 0", "between 1 and 33554432"],
+        ),
+        (
+            &["--max-samples", "40000000", "--samples", "auto"],
+            &["--max-samples 40000000"],
+        ),
+        // The template scene gives `samples = 500`.
+        (
+            &["--max-samples", "1000"],
+            &[
+                "--max-samples 1000",
+                "automatic count only",
+                "samples = 500",
+            ],
+        ),
+        (
+            &["--max-samples", "1000", "--spacing", "0.1"],
+            &["spacing = 0.1", "--samples auto"],
+        ),
+    ];
+    for (extra, needles) in runtime {
+        sb.fails(&render(extra), 1, needles);
+    }
+}
+
+/// The summary line says how the count was chosen; a count far too low for the material gets
+/// one warning, even with `-q`.
+#[test]
+fn sample_count_summary_and_warning() {
+    let sb = Sandbox::new("flags-samples-summary");
+    let out = sb.succeeds(&["scene.toml", "--samples", "auto", "--max-samples", "6000"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains(" samples (auto"), "{stdout}");
+    assert!(stdout.contains("ℓ_d)"), "{stdout}");
+    // The ball's ℓ_d is 0.126 (blue): 20 samples are 3.3 ℓ_d apart, 2 are 11 ℓ_d apart
+    // (a black image needs 100 ℓ_d: the unit tests of `render::density` check that text).
+    let cases = [
+        ("20", "hierarchical", "hierarchical will show blotches"),
+        ("2", "exhaustive", "exhaustive will show blotches"),
+        (
+            "20",
+            "local-global",
+            "local-global will render hard, stair-stepped shadow edges",
+        ),
+    ];
+    for (quiet, (count, method, effect)) in [false, true].into_iter().zip(cases.iter().cycle()) {
+        let mut args = vec!["scene.toml", "--samples", count, "--method", method];
+        if quiet {
+            args.push("-q");
+        }
+        let out = sb.succeeds(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(stderr.matches("warning: ").count(), 1, "{stderr}");
+        assert!(
+            stderr.starts_with("warning: object 'ball': irradiance samples"),
+            "{stderr}"
+        );
+        assert!(stderr.contains(effect), "{stderr}");
+        assert!(
+            stderr.contains("(blue channel of material 'm')"),
+            "{stderr}"
+        );
+        let summary = format!("{count} samples (given: spacing");
+        assert_eq!(stdout.contains(&summary), !quiet, "{stdout}");
+    }
+    for (count, method, effect) in cases {
+        let out = sb.succeeds(&["scene.toml", "-q", "--samples", count, "--method", method]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(effect), "{stderr}");
+    }
+    let out = sb.succeeds(&["bake", "scene.toml", "--samples", "20", "-o", "s.ply"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        stderr.matches("warning: object 'ball'").count(),
+        1,
+        "{stderr}"
+    );
+}

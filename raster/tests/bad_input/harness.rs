@@ -208,7 +208,7 @@ impl Sandbox {
             args.join(" ")
         );
         assert_eq!(out.status.code(), Some(code), "exit code of {ctx}");
-        assert!(stderr.starts_with("error: "), "no error message: {ctx}");
+        assert!(starts_with_error(&stderr), "no error message: {ctx}");
         assert!(!stderr.contains("panicked"), "panic: {ctx}");
         assert!(stdout.is_empty(), "output on stdout: {ctx}");
         for needle in needles {
@@ -234,7 +234,7 @@ impl Sandbox {
                 false
             }
             Some(1) => {
-                assert!(stderr.starts_with("error: "), "no error message: {ctx}");
+                assert!(starts_with_error(&stderr), "no error message: {ctx}");
                 assert!(stderr.contains(needle), "message lacks `{needle}`: {ctx}");
                 self.assert_unchanged(&before, &ctx);
                 true
@@ -273,6 +273,16 @@ impl Drop for Sandbox {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.dir);
     }
+}
+
+/// True if `stderr` is an `error:` message, after at most one `warning:` line (the
+/// under-resolution warning comes as soon as the sample count is known, before later errors).
+fn starts_with_error(stderr: &str) -> bool {
+    let rest = match stderr.strip_prefix("warning: ") {
+        Some(w) => w.split_once('\n').map_or("", |(_, rest)| rest),
+        None => stderr,
+    };
+    rest.starts_with("error: ")
 }
 
 /// The arguments of a quiet render of `scene.toml` plus `extra`.

@@ -144,6 +144,35 @@ fn malformed_scene() {
             &["scene.toml:", "render.samples", "-500"],
         ),
         (
+            "samples not a count",
+            "samples = 500",
+            "samples = \"lots\"",
+            &[
+                "scene.toml:",
+                "render.samples",
+                "`lots` is not a sample count",
+                "\"auto\"",
+            ],
+        ),
+        (
+            "samples beyond the cap",
+            "samples = 500",
+            "samples = 40000000",
+            &["scene.toml:", "render.samples", "1..=33554432", "40000000"],
+        ),
+        (
+            "max_samples with a count",
+            "samples = 500",
+            "samples = 500\nmax_samples = 100",
+            &["scene.toml:", "render.max_samples", "automatic count only"],
+        ),
+        (
+            "max_samples of 0",
+            "samples = 500",
+            "samples = \"auto\"\nmax_samples = 0",
+            &["scene.toml:", "render.max_samples", "1..=33554432 (got 0)"],
+        ),
+        (
             "K_d of 1",
             "kd = [0.8, 0.6, 0.4]",
             "kd = [0.8, 1.0, 0.4]",

@@ -165,7 +165,8 @@ layers = ["local", "depth"]
         s.render,
         RenderSettings {
             method: SssMethod::LocalGlobal,
-            samples: SampleDensity::Spacing(0.05),
+            samples: SampleDensity::Spacing(0.05).into(),
+            max_samples: None,
             epsilon: 0.1,
             smoothing: 2.0,
             ell_min: Some(0.001),

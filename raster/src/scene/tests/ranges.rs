@@ -117,8 +117,14 @@ fn render_and_output_values() {
     expect_all! { R;
         render("aa = 0") => "aa", "render.aa", "1..=8";
         render("aa = 9") => "aa", "render.aa", "1..=8";
-        render("samples = 0") => "samples", "render.samples", "1..=";
+        render("samples = 0") => "samples", "render.samples", "1..=33554432 or \"auto\" (got 0)";
+        render("samples = -7") => "samples", "render.samples", "(got -7)";
         render("samples = 100000000") => "samples", "render.samples", "1..=";
+        render("samples = 33554433") => "samples", "render.samples", "(got 33554433)";
+        render("samples = 'lots'") => "samples", "render.samples", "`lots` is not a sample count";
+        render("samples = 'Auto'") => "samples", "render.samples", "or \"auto\"";
+        render("max_samples = 0") => "max_samples", "render.max_samples", "1..=33554432";
+        render("max_samples = 40000000") => "max_samples", "render.max_samples", "1..=33554432";
         render("epsilon = -0.1") => "epsilon", "render.epsilon", "at least 0";
         render("cull_tolerance = 1") => "cull_tolerance", "render.cull_tolerance", "[0, 1)";
         render("ell_min = 0") => "ell_min", "render.ell_min", "greater than 0";
@@ -129,5 +135,50 @@ fn render_and_output_values() {
         // A sphere of area 4π with samples 1e-4 apart: up to 1.45e9 samples.
         render("spacing = 1e-4") => "spacing", "render.spacing", "units";
         append("[output]\npng = ''\n") => "png", "output.png", "empty";
+    }
+}
+
+#[test]
+fn sample_counts_parse() {
+    let render = |line: &str| {
+        load(&append(&format!("[render]\n{line}\n")))
+            .unwrap()
+            .render
+    };
+    // The default, absent or spelled out.
+    assert_eq!(load(BASE).unwrap().render.samples, SampleRequest::Auto);
+    assert_eq!(render("samples = 'auto'").samples, SampleRequest::Auto);
+    assert_eq!(render("samples = 'auto'").max_samples, None);
+    assert_eq!(
+        render("samples = 'auto'\nmax_samples = 5000").max_samples,
+        Some(5000)
+    );
+    assert_eq!(render("max_samples = 33554432").max_samples, Some(1 << 25));
+    assert_eq!(
+        render("samples = 1").samples,
+        SampleRequest::Density(SampleDensity::Count(1))
+    );
+    assert_eq!(
+        render("samples = 33554432").samples,
+        SampleRequest::Density(SampleDensity::Count(1 << 25))
+    );
+    assert_eq!(
+        render("spacing = 0.5").samples,
+        SampleRequest::Density(SampleDensity::Spacing(0.5))
+    );
+}
+
+#[test]
+fn sample_count_conflicts_and_types() {
+    let render = |line: &str| append(&format!("[render]\n{line}\n"));
+    expect_all! { SceneErrorKind::Conflict;
+        render("samples = 100\nmax_samples = 5000") => "max_samples", "render.max_samples", "gives `samples`";
+        render("spacing = 0.5\nmax_samples = 5000") => "max_samples", "render.max_samples", "gives `spacing`";
+        render("samples = 'auto'\nspacing = 0.5") => "spacing", "render.spacing", "cannot be combined";
+    }
+    expect_all! { SceneErrorKind::WrongType;
+        render("samples = 1.5") => "samples", "render.samples", "an integer) or \"auto\"";
+        render("samples = true") => "samples", "render.samples", "an integer) or \"auto\"";
+        render("max_samples = 'auto'") => "max_samples", "render.max_samples", "invalid type";
     }
 }
