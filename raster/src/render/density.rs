@@ -489,13 +489,10 @@ mod tests {
         assert!(p.count >= 23_000);
         assert_eq!(p.describe(), "auto: spacing 0.0988 = 0.25 ℓ_d");
         assert_eq!(p.warning(SssMethod::Hierarchical, 1.5), None);
-        // The shipped scene keeps the talk's count.
+        // The shipped scene asks for the automatic count.
         let shipped = plan_of(&default_scene());
-        assert_eq!(
-            (shipped.origin, shipped.count),
-            (DensityOrigin::Count, 23_000)
-        );
-        assert_eq!(shipped.describe(), "given: spacing 0.105 = 0.27 ℓ_d");
+        assert_eq!(shipped.count, 25_879);
+        assert!(matches!(shipped.origin, DensityOrigin::Auto { .. }));
     }
 
     #[test]
