@@ -32,14 +32,15 @@ pub struct ObjectCache {
     pub alpha: f32,
     /// Where K comes from (split methods only).
     pub local: Option<LocalTerm>,
-    /// K when the material does not vary over the surface: looked up once here instead of at
-    /// every shading point (a table lookup cost about 6% of a lookup on the sphere).
+    /// K when the material does not vary over the surface: computed once here by quadrature
+    /// ([`LocalTerm::exact`]), so it carries no table interpolation error and costs no
+    /// lookup at the shading points (a table lookup cost about 6% of a lookup on the sphere).
     pub uniform_k: Option<Vec3>,
 }
 
 impl ObjectCache {
-    /// The object's cache, smoothing radius and local term; K is looked up once for a material
-    /// that does not vary.
+    /// The object's cache, smoothing radius and local term; K is computed once, exactly, for a
+    /// material that does not vary.
     pub fn new(
         cache: IrradianceCache,
         alpha: f32,
@@ -51,7 +52,7 @@ impl ObjectCache {
                 let point = shader.at(Vec2::ZERO).map_err(|e| {
                     RenderError::Material(format!("material '{}': {e}", shader.name))
                 })?;
-                Some(term.lookup(&point))
+                Some(term.exact(&point))
             }
             _ => None,
         };
