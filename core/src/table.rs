@@ -8,18 +8,23 @@
 //! radius so that the table is scale invariant (K depends on α/ℓ only; with nodes at absolute
 //! 2^k scene units the same scene in other units saw up to 3.9% different K) — and
 //! interpolated between the two bracketing nodes, so that a texture-mapped ℓ_u costs a lookup
-//! instead of a quadrature.
+//! instead of a quadrature. (A material whose ℓ_u does not vary needs one K per object and
+//! takes it by quadrature, [`LocalIntegralTable::exact_or_limit`].)
 //!
-//! The interpolation is linear in log K against log ℓ. Measured maximum relative error
-//! against the exact K over ℓ/α ∈ [2⁻¹⁰, 2¹⁰] (K_d from 0.05 to 0.99, test
-//! `interpolation_error_is_bounded`), by interpolation variable:
+//! The interpolation is a cubic Hermite in ln K against log₂ ℓ through both bracketing nodes'
+//! values and exact slopes d ln K / d log₂ ℓ (from dK/da by differentiating under the integral,
+//! [`local_integral_slope_unit`]), the slopes limited to Fritsch & Carlson's (1980) monotone
+//! box so that K stays non-increasing. Measured maximum relative error against the exact K
+//! over ℓ/α ∈ [2⁻¹⁰, 2¹⁰] (K_d from 0.05 to 0.99, η from 1.0 to 1.5, 64 points per octave,
+//! test `interpolation_error_is_bounded`), by interpolation:
 //!
-//! | linear in | ℓ | 1/ℓ | 1/ℓ² | log K vs log ℓ (used) |
-//! |---|---|---|---|---|
-//! | max. relative error | 41% | 12.5% | 10.5% | 5.2% |
+//! | interpolation | linear in ℓ | in 1/ℓ | in 1/ℓ² | log K vs log ℓ | Hermite in log K vs log ℓ (used) |
+//! |---|---|---|---|---|---|
+//! | max. relative error | 41% | 12.5% | 10.5% | 5.2% | 0.075% |
 //!
 //! Linear in ℓ fails where K ∝ ℓ⁻² (ℓ ≫ α); every variant peaks near ℓ ≈ 0.7 α, where the
-//! kernel's edge cuts into the profile.
+//! kernel's edge cuts into the profile (the Hermite's worst case: K_d 0.05, η 1.5,
+//! ℓ/α = 2^−0.5). In the ℓ⁻² tail ln K is linear in log ℓ, which the cubic reproduces.
 //!
 //! By the scaling law Rd_ℓ(r) = Rd_1(r/ℓ)/ℓ², K depends only on a = α/ℓ (for fixed α′, η):
 //! K = 2π ∫₀^a w(ρ/a) Rd_1(ρ) ρ dρ. It rises from ≈ π a² Rd_1(0)/3 for a → 0 (ℓ ≫ α) to
@@ -27,7 +32,7 @@
 //!
 //! ```text
 //!  K   limit = Rd_total ●────●
-//!      │                      ╲        cached at ℓ = 2^k (only the k that lookups touch)
+//!      │                      ╲        cached at ℓ = α·2^k (only the k that lookups touch)
 //!      │                       ●──●
 //!      │                           ╲●──●──●──… → 0
 //!      └──────┬────────┬───┬───┬───┬────────── ℓ_u
@@ -37,16 +42,25 @@
 //! Below the user's ℓ_min the limit value is used; between ℓ_min and the first power of two
 //! above it the table interpolates linearly from the limit, so K(ℓ) is continuous everywhere.
 //!
-//! Each node keeps ln K beside K, so that a lookup takes one logarithm (of ℓ/α, shared by the
-//! channels when they have the same ℓ) and one polynomial exponential per channel. It had
-//! taken two libm logarithms and a libm exponential per channel: 814 instructions per
-//! three-channel lookup on the textured slab, now 515 (callgrind, 23k samples, local-global;
-//! a whole shading point there runs about 24 600).
+//! Between nodes k and k + 1, at t = log₂(ℓ/α) − k ∈ [0, 1):
 //!
-//! Concurrency: entries are `AtomicU64` holding K's and ln K's f32 bits, with a NaN pattern
-//! meaning "not yet computed". A lookup that finds an empty entry computes it and stores it with a relaxed
-//! store; two threads racing compute the same bits (the quadrature is deterministic), so no
-//! lock is needed on any path. [`LocalIntegralTable::prefill`] fills a declared range up front.
+//! ```text
+//! K = K_k · e^Δ(t),   Δ(t) = t·(m₀ + t·((3d − 2m₀ − m₁) + t·(m₀ + m₁ − 2d))) ≤ 0,
+//! d = ln K_k+1 − ln K_k,   m₀, m₁ = the nodes' slopes limited to [3d, 0]
+//! ```
+//!
+//! so that Δ(0) = 0 and e^0 = 1 make every node bit-equal to its quadrature, and Δ ≤ 0 lets the
+//! exponential be the polynomial one of `math` (libm's expf costs four times as much). The
+//! cache holds, per segment from node k to k + 1, K_k and the cubic's three coefficients
+//! (computed in double precision from both nodes when the segment is first used), so a lookup
+//! takes one logarithm (of ℓ/α, shared by the channels when they have the same ℓ), one
+//! segment load, a cubic and one polynomial exponential per channel.
+//!
+//! Concurrency: a segment is two `AtomicU64` words (layout at `Segment`) with a NaN pattern
+//! meaning "not yet computed". A lookup that finds an empty word computes the segment and
+//! stores both words with relaxed stores; two threads racing compute the same bits (the
+//! quadrature is deterministic), so each word read is either empty or final, and no lock is
+//! needed on any path. [`LocalIntegralTable::prefill`] fills a declared range up front.
 
 use alloc::vec::Vec;
 use core::sync::atomic::{AtomicU64, Ordering};
@@ -126,34 +140,85 @@ struct Channel {
     limit: f32,
 }
 
-/// One cached node: K, and what the interpolation needs so that a lookup takes no logarithm
-/// of K: ln K and the slope of ln K in log₂ ℓ. Packed into two atomic words:
+/// One cached segment, from node k (ℓ = α·2^k) to node k + 1: K at node k and the coefficients
+/// of ln K(t) − ln K_k (see [`Segment::new`]), so that a lookup takes no logarithm of K and
+/// loads one segment, not two nodes. Packed into two atomic words:
 ///
 /// ```text
-///  word 0:  bits 0–31  K          bits 32–63  ln K
-///  word 1:  bits 0–31  slope      bits 32–63  0      (so never the EMPTY pattern)
+///  word 0:  bits 0–31  K_k     bits 32–63  c₁
+///  word 1:  bits 0–31  c₂      bits 32–63  c₃
 /// ```
+///
+/// (never the EMPTY pattern: K_k is finite, and the c's are finite or the canonical NaN).
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Node {
+struct Segment {
+    /// K at node k, the quadrature's value rounded to f32.
     k: f32,
-    /// ln K (−∞ where K underflowed to 0).
-    ln_k: f32,
-    /// d ln K / d log₂ ℓ = −ln 2 · a·(dK/da)/K ≤ 0 (0 where K is 0).
-    slope: f32,
+    /// Δ(t) = t·(c₁ + t·(c₂ + t·c₃)); c₁ NaN marks a segment interpolated linearly in K
+    /// (where K is 0 at an end).
+    c1: f32,
+    c2: f32,
+    c3: f32,
 }
 
-impl Node {
+impl Segment {
+    /// The segment between two nodes, each given as (K, d ln K / d log₂ ℓ) in double
+    /// precision: the cubic Hermite interpolant of ln K in t = log₂(ℓ/α) − k through both
+    /// values and slopes,
+    ///
+    /// ```text
+    /// Δ(t) = t·(m₀ + t·((3d − 2m₀ − m₁) + t·(m₀ + m₁ − 2d))),   d = ln K_k+1 − ln K_k ≤ 0,
+    /// ```
+    ///
+    /// with the slopes limited to m ∈ [3d, 0] (Fritsch & Carlson 1980: the box α, β ≤ 3 of
+    /// their monotonicity region), so that Δ is non-increasing on [0, 1] and ≤ 0: K = K_k·e^Δ
+    /// needs only the polynomial exp of a non-positive argument, falls with ℓ, is K_k exactly
+    /// at t = 0 (Δ(0) = 0, e^0 = 1) and reaches K_k+1 at t = 1 (Δ(1) = d).
+    fn new(lo: (f64, f64), hi: (f64, f64)) -> Self {
+        let ((k0, m0), (k1, m1)) = (lo, hi);
+        if !(k0 > 0.0 && k1 > 0.0) {
+            // K underflowed at an end: linear in K (K falls with ℓ, so it is 0 at node k + 1).
+            return Segment {
+                k: k0 as f32,
+                c1: f32::NAN,
+                c2: f32::NAN,
+                c3: f32::NAN,
+            };
+        }
+        let d = (math::ln64(k1) - math::ln64(k0)).min(0.0);
+        // max/min, not clamp: no panic path, and a NaN slope becomes a bound.
+        let m0 = m0.max(3.0 * d).min(0.0);
+        let m1 = m1.max(3.0 * d).min(0.0);
+        Segment {
+            k: k0 as f32,
+            c1: m0 as f32,
+            c2: (3.0 * d - 2.0 * m0 - m1) as f32,
+            c3: (m0 + m1 - 2.0 * d) as f32,
+        }
+    }
+
+    /// K at t ∈ [0, 1) along the segment.
+    #[inline(always)]
+    fn at(self, t: f32) -> f32 {
+        if self.c1.is_nan() {
+            self.k * (1.0 - t)
+        } else {
+            self.k * math::exp_nonpositive_poly(t * (self.c1 + t * (self.c2 + t * self.c3)))
+        }
+    }
+
     fn to_bits(self) -> [u64; 2] {
-        [
-            self.k.to_bits() as u64 | (self.ln_k.to_bits() as u64) << 32,
-            self.slope.to_bits() as u64,
-        ]
+        let pack = |lo: f32, hi: f32| lo.to_bits() as u64 | (hi.to_bits() as u64) << 32;
+        [pack(self.k, self.c1), pack(self.c2, self.c3)]
     }
     fn from_bits(bits: [u64; 2]) -> Self {
-        Node {
-            k: f32::from_bits(bits[0] as u32),
-            ln_k: f32::from_bits((bits[0] >> 32) as u32),
-            slope: f32::from_bits(bits[1] as u32),
+        let lo = |w: u64| f32::from_bits(w as u32);
+        let hi = |w: u64| f32::from_bits((w >> 32) as u32);
+        Segment {
+            k: lo(bits[0]),
+            c1: hi(bits[0]),
+            c2: lo(bits[1]),
+            c3: hi(bits[1]),
         }
     }
 }
@@ -178,8 +243,8 @@ pub struct LocalIntegralTable {
     ratio_min: f32,
     /// Exponent of the first cached node: the smallest k with 2^k > ℓ_min / α.
     k_lo: i32,
-    /// `entries[k − k_lo][c]` = the two words of the [`Node`] at ℓ = α·2^k for channel c,
-    /// each `EMPTY` until computed.
+    /// `entries[k − k_lo][c]` = the two words of the [`Segment`] from ℓ = α·2^k to α·2^(k+1)
+    /// for channel c, each `EMPTY` until computed.
     entries: Vec<[[AtomicU64; 2]; 3]>,
 }
 
@@ -280,10 +345,11 @@ impl LocalIntegralTable {
         local_integral_unit(&self.channels[c].unit, self.alpha as f64 / ell as f64) as f32
     }
 
-    /// The cached node at ℓ = α·2^k for channel c, computing it on first use. It depends on k
-    /// alone (a = α/ℓ = 2^−k), not on α: the table is scale invariant.
+    /// The cached segment from node k to k + 1 for channel c, computing it on first use. It
+    /// depends on k alone (a = α/ℓ = 2^−k at its start), not on α: the table is scale
+    /// invariant.
     #[inline(always)]
-    fn node(&self, c: usize, k: i32) -> Node {
+    fn segment(&self, c: usize, k: i32) -> Segment {
         let slots = &self.entries[(k - self.k_lo) as usize][c];
         let bits = [
             slots[0].load(Ordering::Relaxed),
@@ -292,37 +358,35 @@ impl LocalIntegralTable {
         // Each word is either EMPTY or its final value (every thread computes the same bits),
         // so two independent loads are consistent.
         if bits[0] != EMPTY && bits[1] != EMPTY {
-            Node::from_bits(bits)
+            Segment::from_bits(bits)
         } else {
             self.fill(slots, c, k)
         }
     }
 
-    /// Computes and stores a node (out of line: it runs once per node).
+    /// Computes and stores a segment (out of line: it runs once per segment). Its two nodes
+    /// are computed afresh, also where the neighbouring segment has one of them: the
+    /// quadrature is deterministic, so both get the same bits.
     #[cold]
     #[inline(never)]
-    fn fill(&self, slots: &[AtomicU64; 2], c: usize, k: i32) -> Node {
+    fn fill(&self, slots: &[AtomicU64; 2], c: usize, k: i32) -> Segment {
         let unit = &self.channels[c].unit;
-        let a = math::pow2i64(-k);
-        let v = local_integral_unit(unit, a);
-        let node = if v > 0.0 {
-            let a_dk_da = local_integral_slope_unit(unit, a);
-            Node {
-                k: v as f32,
-                ln_k: math::ln64(v) as f32,
-                slope: (-core::f64::consts::LN_2 * a_dk_da / v).min(0.0) as f32,
-            }
-        } else {
-            Node {
-                k: v as f32,
-                ln_k: f32::NEG_INFINITY,
-                slope: 0.0,
-            }
+        let node = |k: i32| {
+            let a = math::pow2i64(-k);
+            let v = local_integral_unit(unit, a);
+            // d ln K / d log₂ ℓ = −ln 2 · a·(dK/da) / K.
+            let slope = if v > 0.0 {
+                -core::f64::consts::LN_2 * local_integral_slope_unit(unit, a) / v
+            } else {
+                0.0
+            };
+            (v, slope)
         };
-        let bits = node.to_bits();
+        let segment = Segment::new(node(k), node(k + 1));
+        let bits = segment.to_bits();
         slots[0].store(bits[0], Ordering::Relaxed);
         slots[1].store(bits[1], Ordering::Relaxed);
-        node
+        segment
     }
 
     /// K(ℓ_u) per channel by power-of-two interpolation (monotone cubic Hermite in log K over
@@ -388,23 +452,16 @@ impl LocalIntegralTable {
     fn value(&self, c: usize, place: Place) -> f32 {
         match place {
             Place::Limit => self.channels[c].limit,
-            Place::Last => self.node(c, K_MAX).k,
+            Place::Last => self.segment(c, K_MAX).k,
             Place::Ramp(t) => {
                 let limit = self.channels[c].limit;
-                limit + (self.node(c, self.k_lo).k - limit) * t
+                limit + (self.segment(c, self.k_lo).k - limit) * t
             }
-            Place::Between { k, t } => {
-                let (lo, hi) = (self.node(c, k), self.node(c, k + 1));
-                if lo.k > 0.0 && hi.k > 0.0 {
-                    lo.k * math::exp_nonpositive_poly(hermite_offset(lo, hi, t))
-                } else {
-                    lo.k + (hi.k - lo.k) * t
-                }
-            }
+            Place::Between { k, t } => self.segment(c, k).at(t),
         }
     }
 
-    /// Computes every node that lookups in [ℓ_lo, ℓ_hi] can touch (all channels), so that
+    /// Computes every segment that lookups in [ℓ_lo, ℓ_hi] can touch (all channels), so that
     /// later lookups in that range never compute.
     pub fn prefill(&self, ell_lo: f32, ell_hi: f32) {
         if !(ell_hi >= ell_lo) || !ell_hi.is_finite() || !(ell_hi > self.ell_min) {
@@ -412,43 +469,28 @@ impl LocalIntegralTable {
         }
         let lo = (ell_lo.max(self.ell_min) / self.alpha).max(f32::MIN_POSITIVE);
         let hi = (ell_hi / self.alpha).min(f32::MAX);
+        // A lookup at ratio r uses the segment of ⌊log₂ r⌋ (the ramp uses the first one).
         let k0 = math::ilog2(lo).max(self.k_lo);
-        let k1 = (math::ilog2(hi) + 1).min(K_MAX);
+        let k1 = math::ilog2(hi).min(K_MAX);
         for k in k0..=k1 {
             for c in 0..3 {
-                self.node(c, k);
+                self.segment(c, k);
             }
         }
     }
 
-    /// The exponents k (nodes at ℓ = α·2^k) computed so far (in any channel), ascending.
+    /// The exponents k of the nodes (ℓ = α·2^k) computed so far (in any channel; segment k
+    /// computes nodes k and k + 1), ascending.
     pub fn cached_exponents(&self) -> impl Iterator<Item = i32> + '_ {
-        self.entries
-            .iter()
-            .enumerate()
-            .filter(|(_, e)| e.iter().any(|w| w[0].load(Ordering::Relaxed) != EMPTY))
-            .map(move |(i, _)| self.k_lo + i as i32)
+        let filled = |i: usize| {
+            self.entries
+                .get(i)
+                .is_some_and(|e| e.iter().any(|w| w[0].load(Ordering::Relaxed) != EMPTY))
+        };
+        (0..=self.entries.len())
+            .filter(move |&i| filled(i) || (i > 0 && filled(i - 1)))
+            .map(move |i| self.k_lo + i as i32)
     }
-}
-
-/// ln K(t) − ln K_k between nodes k and k + 1 (t = log₂(ℓ/α) − k ∈ [0, 1)): the cubic
-/// Hermite interpolant of ln K in log₂ ℓ through both nodes' values and exact slopes,
-///
-/// ```text
-/// Δ(t) = t·(m₀ + t·((3d − 2m₀ − m₁) + t·(m₀ + m₁ − 2d))),   d = ln K_k+1 − ln K_k,
-/// ```
-///
-/// with the slopes limited to m ∈ [3d, 0] (Fritsch & Carlson 1980, the box α, β ≤ 3 of their
-/// monotonicity region), so that Δ is non-increasing and ≤ 0: K = K_k · e^Δ needs only the
-/// polynomial exp of a non-positive argument, falls with ℓ, and is K_k exactly at t = 0
-/// (Δ(0) = 0, e^0 = 1).
-#[inline(always)]
-fn hermite_offset(lo: Node, hi: Node, t: f32) -> f32 {
-    let d = (hi.ln_k - lo.ln_k).min(0.0);
-    // max/min, not clamp: no panic path, and a NaN slope becomes a bound.
-    let m0 = lo.slope.max(3.0 * d).min(0.0);
-    let m1 = hi.slope.max(3.0 * d).min(0.0);
-    t * (m0 + t * ((3.0 * d - 2.0 * m0 - m1) + t * (m0 + m1 - 2.0 * d)))
 }
 
 #[cfg(test)]
@@ -695,7 +737,7 @@ mod tests {
         }
         let (e, kd, eta, x) = worst;
         std::println!("worst relative interpolation error {e:e} (K_d {kd} η {eta} ℓ/α 2^{x})");
-        // Measured: 7.5e-4 (K_d 0.05, η 1.4, ℓ/α = 2^−0.5); log–log linear had 5.2%.
+        // Measured: 7.5e-4 (K_d 0.05, η 1.5, ℓ/α = 2^−0.5); log–log linear had 5.2%.
         assert!(
             e < 1e-3,
             "worst relative interpolation error {e} (K_d {kd} η {eta} ℓ/α 2^{x})"
