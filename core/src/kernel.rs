@@ -110,7 +110,8 @@ mod tests {
             let fd = a * (Kernel::weight_unit(rho / (a + h)) - Kernel::weight_unit(rho / (a - h)))
                 / (2.0 * h);
             let want = Kernel::radius_derivative_unit(u);
-            assert!((fd - want).abs() < 1e-6, "u {u}: {fd} vs {want}");
+            // (At u = 1 the one-sided half of the difference leaves 2h = 2e-6.)
+            assert!((fd - want).abs() < 1e-5, "u {u}: {fd} vs {want}");
         }
         // α = 0 and nonsense radii switch smoothing off.
         for bad in [0.0, -1.0, f32::NAN, 1e-20] {

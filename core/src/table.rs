@@ -83,7 +83,7 @@ const K_MAX: i32 = 127;
 /// 32-point Gauss–Legendre over geometrically growing intervals (the integrand varies on the
 /// scale of ℓ near 0 and decays like e^(−σ_tr ρ)); relative accuracy about 1e-12.
 pub fn local_integral_unit(dipole: &UnitDipole, a: f64) -> f64 {
-    integrate_unit(dipole, a, Kernel::weight_unit)
+    local_integral_and_slope_unit(dipole, a).0
 }
 
 /// a·dK/da, K's derivative in a = α/ℓ_u, by differentiating under the integral:
@@ -95,23 +95,34 @@ pub fn local_integral_unit(dipole: &UnitDipole, a: f64) -> f64 {
 /// (no boundary term: w(1) = 0). It is ≥ 0 (K grows with a, i.e. falls with ℓ), and
 /// d ln K / d ln ℓ = −a·(dK/da)/K. Same quadrature as [`local_integral_unit`].
 pub fn local_integral_slope_unit(dipole: &UnitDipole, a: f64) -> f64 {
-    integrate_unit(dipole, a, Kernel::radius_derivative_unit)
+    local_integral_and_slope_unit(dipole, a).1
 }
 
-/// 2π ∫₀^a weight(ρ/a) Rd_1(ρ) ρ dρ by the composite rule of [`local_integral_unit`].
-fn integrate_unit(dipole: &UnitDipole, a: f64, weight: impl Fn(f64) -> f64) -> f64 {
+/// (K, a·dK/da) in one pass of the composite rule of [`local_integral_unit`]: the two
+/// integrands share Rd_1(ρ), which is most of the cost. K is the same bits whether or not the
+/// slope is wanted (the table's nodes must equal [`local_integral_unit`] exactly).
+pub fn local_integral_and_slope_unit(dipole: &UnitDipole, a: f64) -> (f64, f64) {
     if !(a > 0.0) {
-        return 0.0;
+        return (0.0, 0.0);
     }
     let rule = GaussLegendre::<32>::new();
-    let f = |rho: f64| 2.0 * core::f64::consts::PI * rho * weight(rho / a) * dipole.rd(rho);
+    let f = |rho: f64| {
+        let common = 2.0 * core::f64::consts::PI * rho * dipole.rd(rho);
+        let u = rho / a;
+        (
+            common * Kernel::weight_unit(u),
+            common * Kernel::radius_derivative_unit(u),
+        )
+    };
     // Beyond ρ_end the profile has decayed below e^(−60) of its peak region.
     let end = a.min(60.0 / dipole.sigma_tr().max(1e-300) + 60.0);
-    let mut total = 0.0;
+    let mut total = (0.0, 0.0);
     let mut lo = 0.0;
     let mut hi = end.min(0.125);
     loop {
-        total += rule.integrate(lo, hi, f);
+        let (k, slope) = rule.integrate_pair(lo, hi, f);
+        total.0 += k;
+        total.1 += slope;
         if hi >= end {
             break;
         }
@@ -372,11 +383,10 @@ impl LocalIntegralTable {
     fn fill(&self, slots: &[AtomicU64; 2], c: usize, k: i32) -> Segment {
         let unit = &self.channels[c].unit;
         let node = |k: i32| {
-            let a = math::pow2i64(-k);
-            let v = local_integral_unit(unit, a);
+            let (v, a_dk_da) = local_integral_and_slope_unit(unit, math::pow2i64(-k));
             // d ln K / d log₂ ℓ = −ln 2 · a·(dK/da) / K.
             let slope = if v > 0.0 {
-                -core::f64::consts::LN_2 * local_integral_slope_unit(unit, a) / v
+                -core::f64::consts::LN_2 * a_dk_da / v
             } else {
                 0.0
             };
