@@ -147,7 +147,7 @@ def table_seeds():
     write(t, "sweep-around-alpha", header() + sweep)
     nodes = bytearray()
     for e in range(-30, 31):
-        nodes += bytes([2]) + i8(e)
+        nodes += bytes([2]) + i8(e)  # exactly α·2^e: a node
     write(t, "powers-of-two", header(kd=(300, 30000, 65000), eta=255, alpha=8) + nodes)
     thr = bytearray()
     for v in (-128, -1, 0, 1, 127):

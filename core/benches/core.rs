@@ -249,3 +249,22 @@ fn table_lookup(b: Bencher) {
         acc
     });
 }
+
+/// The same with one ℓ for the three channels (a scalar mean-free-path texture): one
+/// logarithm per lookup instead of three.
+#[divan::bench(counter = divan::counter::ItemsCount::new(1024usize))]
+fn table_lookup_shared(b: Bencher) {
+    let s = setup();
+    let base = s.profile.mean_free_path().x;
+    let ells: Vec<Vec3> = (0..1024)
+        .map(|i| Vec3::splat(base * (0.1 + 9.9 * i as f32 / 1024.0)))
+        .collect();
+    s.table.prefill(base * 0.1, base * 10.0);
+    b.bench(|| {
+        let mut acc = Vec3::ZERO;
+        for &l in &ells {
+            acc += s.table.lookup(black_box(l));
+        }
+        acc
+    });
+}

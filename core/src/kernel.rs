@@ -71,6 +71,16 @@ impl Kernel {
             t * t
         }
     }
+    /// How w(ρ/a) changes with the radius a, times a, at u = ρ/a:
+    /// a·∂w(ρ/a)/∂a = −u·w′(u) = 4u²(1 − u²) for u < 1, 0 beyond (double precision, for the
+    /// derivative of the local integral in the radius). It vanishes at u = 1 like w itself.
+    pub fn radius_derivative_unit(u: f64) -> f64 {
+        if u >= 1.0 {
+            0.0
+        } else {
+            4.0 * u * u * (1.0 - u * u)
+        }
+    }
 }
 
 #[cfg(test)]
@@ -93,6 +103,15 @@ mod tests {
             .enumerate()
         {
             assert!((lanes[i] - k.weight(*r2)).abs() < 1e-7);
+        }
+        // The radius derivative against a central difference of w(ρ/a) in a.
+        for u in [0.0, 0.1, 0.5, 0.9, 0.999, 1.0, 2.0] {
+            let (rho, a, h) = (u, 1.0, 1e-6);
+            let fd = a * (Kernel::weight_unit(rho / (a + h)) - Kernel::weight_unit(rho / (a - h)))
+                / (2.0 * h);
+            let want = Kernel::radius_derivative_unit(u);
+            // (At u = 1 the one-sided half of the difference leaves 2h = 2e-6.)
+            assert!((fd - want).abs() < 1e-5, "u {u}: {fd} vs {want}");
         }
         // α = 0 and nonsense radii switch smoothing off.
         for bad in [0.0, -1.0, f32::NAN, 1e-20] {

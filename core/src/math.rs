@@ -37,6 +37,12 @@ pub fn ln(x: f32) -> f32 {
     libm::logf(x)
 }
 
+/// Natural logarithm in double precision (libm).
+#[inline]
+pub fn ln64(x: f64) -> f64 {
+    libm::log(x)
+}
+
 /// Base-2 logarithm (libm).
 #[inline]
 pub fn log2(x: f32) -> f32 {
@@ -66,6 +72,13 @@ pub fn cos64(x: f64) -> f64 {
 pub fn pow2i(k: i32) -> f32 {
     debug_assert!((-126..=127).contains(&k));
     f32::from_bits(((k + 127) as u32) << 23)
+}
+
+/// 2^k in double precision for an integer k in [−1022, 1023] (exact; from the exponent bits).
+#[inline]
+pub fn pow2i64(k: i32) -> f64 {
+    debug_assert!((-1022..=1023).contains(&k));
+    f64::from_bits(((k + 1023) as u64) << 52)
 }
 
 /// The floor of log₂ x for finite positive normal x, read off the exponent bits.

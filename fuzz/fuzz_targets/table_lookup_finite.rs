@@ -1,5 +1,5 @@
 //! Property: for any K_d, η, α, ℓ_min, every local-integral lookup is finite, in [0, Rd_total],
-//! exact at cached powers of two, and non-increasing in ℓ.
+//! exact at the nodes ℓ = α·2^k, and non-increasing in ℓ.
 #![no_main]
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {

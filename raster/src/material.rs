@@ -338,6 +338,20 @@ pub enum LocalTerm {
 }
 
 impl LocalTerm {
+    /// K at a surface point of a material that does not vary over the surface, by quadrature
+    /// (no interpolation error: one quadrature per channel, so once per object, not per
+    /// point). As [`LocalTerm::lookup`], ℓ_u ≤ ℓ_min gives the limit Rd_total.
+    pub fn exact(&self, point: &PointMaterial) -> Vec3 {
+        match self {
+            LocalTerm::Single(table) => table.exact_or_limit(point.profile.mean_free_path()),
+            LocalTerm::Levels { alpha, ell_min, .. } => {
+                LocalIntegralTable::new(&point.profile, *alpha, *ell_min)
+                    .map(|t| t.exact_or_limit(point.profile.mean_free_path()))
+                    .unwrap_or_else(|_| self.lookup(point))
+            }
+        }
+    }
+
     /// K at a surface point.
     pub fn lookup(&self, point: &PointMaterial) -> Vec3 {
         let ell = point.profile.mean_free_path();

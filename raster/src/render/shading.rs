@@ -32,14 +32,15 @@ pub struct ObjectCache {
     pub alpha: f32,
     /// Where K comes from (split methods only).
     pub local: Option<LocalTerm>,
-    /// K when the material does not vary over the surface: looked up once here instead of at
-    /// every shading point (a table lookup cost about 6% of a lookup on the sphere).
+    /// K when the material does not vary over the surface: computed once here by quadrature
+    /// ([`LocalTerm::exact`]), so it carries no table interpolation error and costs no
+    /// lookup at the shading points (a table lookup cost about 6% of a lookup on the sphere).
     pub uniform_k: Option<Vec3>,
 }
 
 impl ObjectCache {
-    /// The object's cache, smoothing radius and local term; K is looked up once for a material
-    /// that does not vary.
+    /// The object's cache, smoothing radius and local term; K is computed once, exactly, for a
+    /// material that does not vary.
     pub fn new(
         cache: IrradianceCache,
         alpha: f32,
@@ -51,7 +52,7 @@ impl ObjectCache {
                 let point = shader.at(Vec2::ZERO).map_err(|e| {
                     RenderError::Material(format!("material '{}': {e}", shader.name))
                 })?;
-                Some(term.lookup(&point))
+                Some(term.exact(&point))
             }
             _ => None,
         };
@@ -353,12 +354,139 @@ struct Surface {
 mod tests {
     use std::borrow::Cow;
 
-    use glam::Vec3;
     use lucent_core::{Distance, Profile, fresnel};
 
-    use super::outgoing_cosine;
-    use crate::render::{RenderOptions, render};
-    use crate::scene::{SceneOrigin, parse_scene};
+    use super::*;
+    use crate::render::irradiance::build_caches;
+    use crate::render::{RenderOptions, bake, render};
+    use crate::scene::{Material, Medium, SceneOrigin, TranslucentMaterial, parse_scene};
+    use lucent_core::dipole::UnitDipole;
+    use lucent_core::table::local_integral_unit;
+
+    /// K by a quadrature of its own for each channel of `profile` (the definition, not the
+    /// table's code path).
+    fn quadrature_k(profile: &lucent_core::Profile, alpha: f32) -> Vec3 {
+        let eta = f64::from(profile.eta());
+        Vec3::from(profile.channels().map(|d| {
+            let a = f64::from(alpha) / f64::from(d.mean_free_path());
+            local_integral_unit(&UnitDipole::new(d.albedo(), eta), a) as f32
+        }))
+    }
+
+    /// A uniform material's K in the object cache is the quadrature to f32 rounding, not the
+    /// table's interpolation (which differs from it by more here).
+    #[test]
+    fn uniform_k_is_the_quadrature() {
+        let shader = match Shader::new(&Material::Translucent(TranslucentMaterial {
+            name: "marble".into(),
+            medium: Medium::Preset {
+                name: "marble".into(),
+                mm_per_unit: 10.0,
+            },
+            specular: None,
+        }))
+        .unwrap()
+        {
+            Shader::Translucent(t) => *t,
+            Shader::Lambert { .. } => unreachable!(),
+        };
+        let profile = shader.at(Vec2::ZERO).unwrap().profile;
+        let ell = profile.mean_free_path();
+        for alpha in [0.01_f32, 0.03, 0.05, 0.2] {
+            let local = shader.local_term(alpha, alpha / 1024.0).unwrap();
+            let LocalTerm::Single(table) = &local else {
+                panic!("a preset has one table")
+            };
+            let interpolated = table.lookup(ell);
+            let oc = ObjectCache::new(
+                IrradianceCache::build(&[]).unwrap(),
+                alpha,
+                Some(local),
+                Some(&shader),
+            )
+            .unwrap();
+            let got = oc.uniform_k.expect("uniform material");
+            let want = quadrature_k(&profile, alpha);
+            let error = ((got - want) / want).abs().max_element();
+            assert!(error <= f32::EPSILON, "α {alpha}: K {got} vs {want}");
+            assert!(
+                ((interpolated - want) / want).abs().max_element() > 1e-5,
+                "α {alpha}: the table's {interpolated} is no test of exactness"
+            );
+        }
+    }
+
+    /// End to end: a uniformly lit marble plane's `local` layer is E·K with K by quadrature
+    /// at the render's own smoothing radius (from the same baked samples).
+    #[test]
+    fn lit_plane_local_layer_is_e_times_exact_k() {
+        let text = r#"
+[camera]
+position = [0.0, 0.0, 30.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 2.0
+width = 8
+height = 8
+
+[[object]]
+name = "slab"
+shape = "plane"
+size = [4.0, 4.0]
+material = "marble"
+
+[material.marble]
+type = "translucent"
+preset = "marble"
+mm_per_unit = 10.0
+
+[[light]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = 2.0
+
+[render]
+method = "local-global"
+samples = 8000
+aa = 1
+"#;
+        let scene = parse_scene(
+            text,
+            &SceneOrigin::Embedded {
+                name: "plane.toml".into(),
+                files: Vec::new(),
+            },
+        )
+        .unwrap();
+        let sets = bake(&scene, false).unwrap();
+        let alpha = build_caches(&sets).unwrap()[0].smoothing_radius(scene.render.smoothing);
+        let Shader::Translucent(shader) = Shader::new(&scene.materials[0]).unwrap() else {
+            panic!("marble is translucent")
+        };
+        let profile = shader.at(Vec2::ZERO).unwrap().profile;
+        let k = quadrature_k(&profile, alpha);
+        let r = render(
+            &scene,
+            &RenderOptions {
+                baked: Some(&sets),
+                ..RenderOptions::default()
+            },
+        )
+        .unwrap();
+        for p in &r.pixels {
+            assert!(
+                (p.irradiance - Vec3::splat(2.0)).abs().max_element() < 1e-4,
+                "E {}",
+                p.irradiance
+            );
+            let want = p.irradiance * k;
+            assert!(
+                ((p.local - want) / want).abs().max_element() <= 2.0 * f32::EPSILON,
+                "local {} vs E·K {want} (α {alpha})",
+                p.local
+            );
+        }
+    }
 
     #[test]
     fn the_outgoing_cosine_is_positive_on_every_visible_surface() {

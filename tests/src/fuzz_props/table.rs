@@ -11,7 +11,7 @@
 //! ell_min                    0: zero, 1: α·2^(i8/4), 2: raw f32, 3: a subnormal (u8 bits)
 //! prefill                    two ℓ (as below), when flag bit 5 is set
 //! lookups …                  until the input ends (at most 64), mode b mod 4 then:
-//!                            0: raw f32, 1: α·2^(i8/8)·(1 + b/256), 2: exactly 2^i8,
+//!                            0: raw f32, 1: α·2^(i8/8)·(1 + b/256), 2: α·2^i8 (a node),
 //!                            3: ℓ_min·(1 + i8·2⁻²⁰) (around the threshold)
 //! ```
 //!
@@ -23,10 +23,12 @@
 //!   non-finite or negative ℓ_min.
 //! - The limit equals the profile's Rd_total and lies in [0, 1].
 //! - Every lookup is finite, ≥ 0 and ≤ Rd_total·(1 + 1e-5); ℓ ≤ ℓ_min or non-finite gives
-//!   the limit exactly; a lookup at a cached power of two equals the exact quadrature bit for
-//!   bit (the table's documented node property).
+//!   the limit exactly; a lookup at a node ℓ = α·2^k (k above ℓ_min/α's exponent, ℓ/α exact in
+//!   f32) equals the exact quadrature bit for bit (the table's documented node property). The
+//!   nodes are powers of two of ℓ/α, not of ℓ (the table is scale invariant): a power of two ℓ
+//!   with α not one is between nodes, where the interpolation is within 0.1 %, not exact.
 //! - For one table, K is non-increasing in ℓ (up to a relative 2e-6 of rounding in the
-//!   log–log interpolation), whatever order lookups (and a prefill) happen in.
+//!   interpolation's polynomial exp), whatever order lookups (and a prefill) happen in.
 
 use lucent_core::glam::Vec3;
 use lucent_core::{Distance, LocalIntegralTable, Profile};
@@ -40,19 +42,30 @@ fn ell(r: &mut Input, alpha: f32, ell_min: f32) -> f32 {
     match r.u8() % 4 {
         0 => r.f32_bits(),
         1 => alpha * pow2(i32::from(r.i8()) / 8) * (1.0 + f32::from(r.u8()) / 256.0),
-        2 => pow2(i32::from(r.i8())),
+        2 => alpha * pow2(i32::from(r.i8())),
         _ => ell_min * (1.0 + f32::from(r.i8()) * pow2(-20)),
     }
 }
 
-/// The smallest power of two strictly above ℓ_min (the table's first node), as documented.
-fn first_node(ell_min: f32) -> f32 {
-    if ell_min < f32::MIN_POSITIVE {
+/// The smallest power of two strictly above ℓ_min/α: the table's first node ℓ = α·2^k, in
+/// units of α, as documented.
+fn first_node_ratio(alpha: f32, ell_min: f32) -> f32 {
+    let ratio_min = ell_min / alpha;
+    if !(ratio_min >= f32::MIN_POSITIVE) {
         pow2(-126)
+    } else if !ratio_min.is_finite() {
+        pow2(127)
     } else {
-        let k = ((ell_min.to_bits() >> 23) as i32 - 127 + 1).min(127);
+        let k = ((ratio_min.to_bits() >> 23) as i32 - 127 + 1).min(127);
         pow2(k)
     }
+}
+
+/// Whether ℓ is exactly a node α·2^k: ℓ/α is a power of two and ℓ is exactly α times it (no
+/// rounding in the product, so the quadrature at α/ℓ sees exactly 2^−k).
+fn is_node(alpha: f32, l: f32) -> bool {
+    let ratio = l / alpha;
+    is_power_of_two(ratio) && f64::from(alpha) * f64::from(ratio) == f64::from(l)
 }
 
 fn is_power_of_two(x: f32) -> bool {
@@ -132,7 +145,7 @@ pub fn table_lookup_finite(data: &[u8]) {
         let (a, b) = (ell(&mut r, alpha, ell_min), ell(&mut r, alpha, ell_min));
         table.prefill(a, b);
     }
-    let first = first_node(ell_min);
+    let first = first_node_ratio(alpha, ell_min);
     let mut seen: Vec<(f32, Vec3)> = Vec::new();
     while !r.is_empty() && seen.len() < MAX_LOOKUPS {
         let l = ell(&mut r, alpha, ell_min);
@@ -146,7 +159,7 @@ pub fn table_lookup_finite(data: &[u8]) {
         if !(l > ell_min) || !l.is_finite() {
             assert_eq!(k, limit, "{what}: below ℓ_min the limit is used");
         }
-        if is_power_of_two(l) && l > ell_min && l >= first {
+        if l > ell_min && is_node(alpha, l) && l / alpha >= first {
             let exact = table.exact(Vec3::splat(l));
             assert_eq!(k, exact, "{what}: a node must equal the exact quadrature");
         }
