@@ -25,11 +25,13 @@ pub mod rng;
 mod strata;
 mod stratified;
 mod surface;
+mod voronoi;
 
 pub use error::{MAX_SAMPLES, SamplingError};
 pub use poisson::poisson_samples;
 pub use stratified::{StratifiedSquare, stratified_square};
 pub use surface::{SampleTarget, SurfacePoint, hex_spacing, total_area, triangle_area};
+pub use voronoi::{VoronoiAreas, VoronoiStats, voronoi_areas};
 
 #[cfg(test)]
 mod tests;
