@@ -127,6 +127,18 @@ impl Cells {
         unpack(self.cell_key[c])
     }
 
+    /// Distance from `p` (in the cell at coordinates `c`) to the boundary of the block of cells
+    /// within `k` of `c`: every site closer than that to `p` is in [`Cells::gather`]'s block.
+    pub(super) fn block_margin(&self, p: DVec3, c: [i64; 3], k: i64) -> f64 {
+        (0..3).fold(f64::INFINITY, |m, a| {
+            let lo = self.origin[a] + (c[a] - k) as f64 * self.size;
+            let hi = self.origin[a] + (c[a] + k + 1) as f64 * self.size;
+            m.min(p[a] - lo).min(hi - p[a])
+        })
+        // Never below the guaranteed k cells (rounding in the box).
+        .max(k as f64 * self.size)
+    }
+
     /// Sorted site range of occupied cell `c`.
     pub(super) fn sites_of(&self, c: usize) -> std::ops::Range<usize> {
         self.cell_start[c] as usize..self.cell_start[c + 1] as usize
@@ -187,33 +199,67 @@ impl Cells {
     /// occupied cells its bounding box, grown by `reach`, overlaps. `live[t]` is false for
     /// triangles without area, which no cell gets.
     pub(super) fn register_triangles(&mut self, triangles: &[[Vec3; 3]], live: &[bool], reach: f64) {
-        let this = &*self;
-        let mut pairs: Vec<u64> = triangles
+        let lists: Vec<Vec<u32>> = triangles
             .par_iter()
             .enumerate()
-            .filter(|&(t, _)| live[t])
-            .flat_map_iter(|(t, tri)| {
+            .map(|(t, tri)| {
                 let mut cells = Vec::new();
-                this.cells_near(tri, reach, &mut cells);
-                cells.sort_unstable();
-                cells.dedup();
+                if live[t] {
+                    self.cells_near(tri, reach, &mut cells);
+                    cells.sort_unstable();
+                    cells.dedup();
+                    cells.shrink_to_fit();
+                }
                 cells
-                    .into_iter()
-                    .map(move |c| ((c as u64) << 32) | t as u64)
             })
             .collect();
-        pairs.par_sort_unstable();
-        let mut tri_start = Vec::with_capacity(self.len() + 1);
-        let mut k = 0;
-        for c in 0..self.len() as u64 {
-            tri_start.push(k as u32);
-            while k < pairs.len() && pairs[k] >> 32 == c {
-                k += 1;
+        // Counting sort by cell; triangles are visited in index order, so each cell's list
+        // comes out ascending.
+        let mut start = vec![0u32; self.len() + 1];
+        for list in &lists {
+            for &c in list {
+                start[c as usize + 1] += 1;
             }
         }
-        tri_start.push(pairs.len() as u32);
-        self.tris = pairs.iter().map(|&p| p as u32).collect();
-        self.tri_start = tri_start;
+        for c in 0..self.len() {
+            start[c + 1] += start[c];
+        }
+        let mut tris = vec![0u32; start[self.len()] as usize];
+        let mut next = start.clone();
+        for (t, list) in lists.iter().enumerate() {
+            for &c in list {
+                tris[next[c as usize] as usize] = t as u32;
+                next[c as usize] += 1;
+            }
+        }
+        self.tris = tris;
+        self.tri_start = start;
+    }
+
+    /// For a walk over the occupied cells in key order: the index of the first occupied cell
+    /// with key ≥ that of coordinates `c` (clamped into the grid), from a cursor that only moves
+    /// forward (`from`).
+    pub(super) fn seek(&self, c: [i64; 3], from: usize) -> usize {
+        let key = pack(c.map(|x| x.clamp(0, AXIS_MAX)));
+        let mut k = from;
+        // Short hops are the rule (the next column is close); far ones binary-search.
+        let mut step = 1;
+        while k + step < self.len() && self.cell_key[k + step] < key {
+            k += step;
+            step *= 2;
+        }
+        k + self.cell_key[k..self.len().min(k + step + 1)].partition_point(|&x| x < key)
+    }
+
+    /// The sorted site range of the occupied cells from index `first` on whose keys are at most
+    /// that of coordinates `last` (the cells of one z column, from a [`Cells::seek`] cursor).
+    pub(super) fn column_sites(&self, first: usize, last: [i64; 3]) -> (u32, u32) {
+        let key = pack(last.map(|x| x.clamp(0, AXIS_MAX)));
+        let mut end = first;
+        while end < self.len() && self.cell_key[end] <= key {
+            end += 1;
+        }
+        (self.cell_start[first], self.cell_start[end])
     }
 
     /// The occupied cells near a triangle (see [`Cells::register_triangles`]).

@@ -166,7 +166,7 @@ pub fn voronoi_areas(triangles: &[[Vec3; 3]], sites: &[Vec3]) -> VoronoiAreas {
     for (&k, &a) in order.iter().zip(&areas) {
         let i = finite[k as usize] as usize;
         out.stats.empty += (a <= 0.0) as u64;
-        out.areas[i] = (a as f32).max(f32::MIN_POSITIVE);
+        out.areas[i] = a.max(f32::MIN_POSITIVE);
     }
     out
 }
@@ -185,18 +185,19 @@ struct Scratch {
     block: Vec<u32>,
     neighbours: Vec<Neighbour>,
     wide: Vec<Neighbour>,
+    far: Vec<Neighbour>,
     gathered: Vec<u32>,
     polygon: Polygon,
 }
 
 impl Pass<'_> {
     /// Areas per sorted site, and the counters.
-    fn run(&self) -> (Vec<f64>, VoronoiStats) {
+    fn run(&self) -> (Vec<f32>, VoronoiStats) {
         let cells = self.cells;
         let n = cells.sites.len();
         let flags: Vec<AtomicU8> = (0..self.triangles.len()).map(|_| AtomicU8::new(0)).collect();
         let (clipped, widened, shared) = (AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0));
-        let mut areas = vec![0.0f64; n];
+        let mut areas = vec![0.0f32; n];
         // Tasks of CELLS_PER_TASK cells, each with its slice of the output.
         let mut tasks = Vec::new();
         let mut rest = &mut areas[..];
@@ -212,8 +213,22 @@ impl Pass<'_> {
             .for_each_init(Scratch::default, |scratch, (range, out)| {
                 let base = cells.sites_of(range.start).start;
                 let mut counts = [0u64; 3];
-                for c in range {
-                    self.cell(c, &mut out[..], base, &flags, scratch, &mut counts);
+                let mut cursors = [0usize; 9];
+                for (k, c) in range.clone().enumerate() {
+                    let home = cells.cell_coords(c);
+                    scratch.block.clear();
+                    for (col, cursor) in cursors.iter_mut().enumerate() {
+                        let (dx, dy) = (col as i64 / 3 - 1, col as i64 % 3 - 1);
+                        let (x, y) = (home[0] + dx, home[1] + dy);
+                        if x < 0 || y < 0 {
+                            continue;
+                        }
+                        let from = if k == 0 { 0 } else { *cursor };
+                        *cursor = cells.seek([x, y, home[2] - 1], from);
+                        let (a, b) = cells.column_sites(*cursor, [x, y, home[2] + 1]);
+                        scratch.block.extend(a..b);
+                    }
+                    self.cell(c, home, &mut out[..], base, &flags, scratch, &mut counts);
                 }
                 clipped.fetch_add(counts[0], Ordering::Relaxed);
                 widened.fetch_add(counts[1], Ordering::Relaxed);
@@ -243,7 +258,7 @@ impl Pass<'_> {
         let mut extra: Vec<(u32, u32, f64)> = extra.into_iter().flatten().collect();
         extra.sort_unstable_by_key(|&(s, t, _)| (s, t));
         for (s, _, a) in extra {
-            areas[s as usize] += a;
+            areas[s as usize] += a as f32;
         }
         if stats.shared > 0 {
             self.share_coincident(&mut areas);
@@ -253,23 +268,24 @@ impl Pass<'_> {
 
     /// The first pass over the sites of occupied cell `c`; `out[k − base]` is sorted site k's
     /// area. `counts`: pairs clipped, widened, coincident sites.
+    #[allow(clippy::too_many_arguments)]
     fn cell(
         &self,
         c: usize,
-        out: &mut [f64],
+        home: [i64; 3],
+        out: &mut [f32],
         base: usize,
         flags: &[AtomicU8],
         scratch: &mut Scratch,
         counts: &mut [u64; 3],
     ) {
         let cells = self.cells;
-        scratch.block.clear();
-        cells.gather(cells.cell_coords(c), 1, &mut scratch.block);
         let triangles = cells.triangles_of(c);
         for s in cells.sites_of(c) {
             let ps = cells.sites[s].as_dvec3();
+            let guaranteed = cells.block_margin(ps, home, 1);
             let mut neighbours = std::mem::take(&mut scratch.neighbours);
-            self.sorted_neighbours(s, ps, &scratch.block, &mut neighbours);
+            self.sorted_neighbours(s, ps, &scratch.block, guaranteed, &mut neighbours, &mut scratch.far);
             counts[2] += neighbours.iter().take_while(|n| n.0 == 0.0).count().min(1) as u64;
             let mut area = 0.0;
             for &t in triangles {
@@ -281,10 +297,9 @@ impl Pass<'_> {
                     continue;
                 };
                 counts[0] += 1;
-                let mut outcome =
-                    scratch
-                        .polygon
-                        .clip_cell(&frame, ps, &neighbours, cells.size);
+                let mut outcome = scratch
+                    .polygon
+                    .clip_cell(&frame, ps, &neighbours, guaranteed);
                 if let Outcome::NeedMore(r2) = outcome {
                     counts[1] += 1;
                     outcome = self.clip_wide(s, ps, &frame, r2, scratch);
@@ -303,18 +318,40 @@ impl Pass<'_> {
                 }
             }
             scratch.neighbours = neighbours;
-            out[s - base] = area;
+            out[s - base] = area as f32;
         }
     }
 
-    /// The sites of `candidates` other than `s`, nearest first (ties by index).
-    fn sorted_neighbours(&self, s: usize, ps: DVec3, candidates: &[u32], out: &mut Vec<Neighbour>) {
+    /// The sites of `candidates` other than `s`: those closer than `guaranteed` first, nearest
+    /// first (ties by index), then the others in candidate order. The order of the others does
+    /// not matter: they are all beyond the guaranteed radius, which alone then decides when the
+    /// clipping may stop.
+    fn sorted_neighbours(
+        &self,
+        s: usize,
+        ps: DVec3,
+        candidates: &[u32],
+        guaranteed: f64,
+        out: &mut Vec<Neighbour>,
+        far: &mut Vec<Neighbour>,
+    ) {
         out.clear();
-        out.extend(candidates.iter().filter(|&&j| j as usize != s).map(|&j| {
+        far.clear();
+        let g2 = guaranteed * guaranteed;
+        for &j in candidates {
+            if j as usize == s {
+                continue;
+            }
             let pj = self.cells.sites[j as usize].as_dvec3();
-            (ps.distance_squared(pj), j, pj)
-        }));
+            let d2 = ps.distance_squared(pj);
+            if d2 <= g2 {
+                out.push((d2, j, pj));
+            } else {
+                far.push((d2, j, pj));
+            }
+        }
         out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        out.extend_from_slice(far);
     }
 
     /// Clips site `s`'s cell on `frame` with every neighbour out to twice the polygon radius
@@ -338,13 +375,20 @@ impl Pass<'_> {
             scratch.gathered.clear();
             cells.gather(home, k, &mut scratch.gathered);
             let everyone = scratch.gathered.len() == cells.sites.len();
-            let mut wide = std::mem::take(&mut scratch.wide);
-            self.sorted_neighbours(s, ps, &scratch.gathered, &mut wide);
             let guaranteed = if everyone {
                 f64::INFINITY
             } else {
-                k as f64 * cells.size
+                cells.block_margin(ps, home, k)
             };
+            let mut wide = std::mem::take(&mut scratch.wide);
+            self.sorted_neighbours(
+                s,
+                ps,
+                &scratch.gathered,
+                guaranteed,
+                &mut wide,
+                &mut scratch.far,
+            );
             let outcome = scratch.polygon.clip_cell(frame, ps, &wide, guaranteed);
             scratch.wide = wide;
             match outcome {
@@ -430,7 +474,7 @@ impl Pass<'_> {
 
     /// Divides the area of sites at exactly the same position by their number (each computed
     /// the same whole cell). Coincident sites share a grid cell.
-    fn share_coincident(&self, areas: &mut [f64]) {
+    fn share_coincident(&self, areas: &mut [f32]) {
         let cells = self.cells;
         for c in 0..cells.len() {
             let range = cells.sites_of(c);
@@ -439,7 +483,7 @@ impl Pass<'_> {
                     .clone()
                     .filter(|&j| cells.sites[j] == cells.sites[s])
                     .count();
-                areas[s] /= same as f64;
+                areas[s] /= same as f32;
             }
         }
     }
