@@ -314,8 +314,15 @@ mod uniform_plane {
     }
 
     /// The scene: `incidence` in degrees from the normal, the light delivering E = 2 on the
-    /// plane; samples at [`DENSITY`].
-    pub fn scene(m: &Material, incidence: f32, method: &str, width: u32, seed: u64) -> Scene {
+    /// plane; samples at [`DENSITY`]; the cluster threshold `epsilon`.
+    pub fn scene(
+        m: &Material,
+        incidence: f32,
+        method: &str,
+        epsilon: f32,
+        width: u32,
+        seed: u64,
+    ) -> Scene {
         let (s, c) = incidence.to_radians().sin_cos();
         let samples = (DENSITY * (m.size * m.size) as f64).round() as u32;
         let text = format!(
@@ -346,7 +353,7 @@ irradiance = {e}
 [render]
 method = "{method}"
 samples = {samples}
-epsilon = 0.5
+epsilon = {epsilon}
 aa = 1
 seed = {seed}
 "#,
@@ -375,44 +382,46 @@ seed = {seed}
         pub global: Vec3,
     }
 
-    /// Renders `scene` from its baked samples, with their Voronoi areas or (with `equal`) every
+    /// Renders `scene` from one baked sample set twice: with its Voronoi areas, and with every
     /// area set to the total over the count, as before per-sample areas.
-    pub fn measure(scene: &Scene, m: &Material, equal: bool, exact_k: bool) -> Outcome {
-        let mut sets: Vec<ObjectSamples> = bake(scene, false).unwrap();
-        if equal {
-            let total: f64 = sets.iter().flat_map(|s| &s.areas).map(|&a| a as f64).sum();
-            let n: usize = sets.iter().map(|s| s.len()).sum();
-            for s in &mut sets {
-                s.areas.fill((total / n as f64) as f32);
+    pub fn measure(scene: &Scene, m: &Material, exact_k: bool) -> (Outcome, Outcome) {
+        let sets: Vec<ObjectSamples> = bake(scene, false).unwrap();
+        let mut equal = sets.clone();
+        let total: f64 = sets.iter().flat_map(|s| &s.areas).map(|&a| a as f64).sum();
+        let n: usize = sets.iter().map(|s| s.len()).sum();
+        for s in &mut equal {
+            s.areas.fill((total / n as f64) as f32);
+        }
+        let run = |sets: &[ObjectSamples]| {
+            let r = render(
+                scene,
+                &RenderOptions {
+                    baked: Some(sets),
+                    exact_local_integral: exact_k,
+                    irradiance_layer: true,
+                    ..RenderOptions::default()
+                },
+            )
+            .unwrap();
+            let rd = (m.profile)().total_reflectance();
+            let n = r.pixels.len() as f32;
+            let mut o = Outcome::default();
+            let rel: Vec<Vec3> = r
+                .pixels
+                .iter()
+                .map(|p| p.exitance / (p.irradiance * rd))
+                .collect();
+            let mean = rel.iter().copied().sum::<Vec3>() / n;
+            let var = rel.iter().map(|&x| (x - mean) * (x - mean)).sum::<Vec3>() / n;
+            o.bias = mean - Vec3::ONE;
+            o.noise = Vec3::new(var.x.sqrt(), var.y.sqrt(), var.z.sqrt()) / mean;
+            for p in &r.pixels {
+                o.local += p.local / (p.irradiance * rd) / n;
+                o.global += p.global / (p.irradiance * rd) / n;
             }
-        }
-        let r = render(
-            scene,
-            &RenderOptions {
-                baked: Some(&sets),
-                exact_local_integral: exact_k,
-                irradiance_layer: true,
-                ..RenderOptions::default()
-            },
-        )
-        .unwrap();
-        let rd = (m.profile)().total_reflectance();
-        let n = r.pixels.len() as f32;
-        let mut o = Outcome::default();
-        let rel: Vec<Vec3> = r
-            .pixels
-            .iter()
-            .map(|p| p.exitance / (p.irradiance * rd))
-            .collect();
-        let mean = rel.iter().copied().sum::<Vec3>() / n;
-        let var = rel.iter().map(|&x| (x - mean) * (x - mean)).sum::<Vec3>() / n;
-        o.bias = mean - Vec3::ONE;
-        o.noise = Vec3::new(var.x.sqrt(), var.y.sqrt(), var.z.sqrt()) / mean;
-        for p in &r.pixels {
-            o.local += p.local / (p.irradiance * rd) / n;
-            o.global += p.global / (p.irradiance * rd) / n;
-        }
-        o
+            o
+        };
+        (run(&sets), run(&equal))
     }
 
     /// The largest-magnitude component, keeping its sign.
@@ -423,32 +432,46 @@ seed = {seed}
     }
 }
 
-/// Per-sample (Voronoi) areas make the exitance of a uniformly lit plane exact in the mean and
-/// nearly flat per pixel for the split methods. Marble (the default scene's material) at the
-/// default scene's sample density, normal incidence, two seeds at 24² pixels over the middle
-/// 2 units. The local term is computed with exact K at every point (`exact_local_integral`),
-/// so what is measured is the quadrature of the global sum, not the K table. The same baked
-/// samples with equal areas (total / N) must be clearly worse, so the test sees the change.
+/// Per-sample (Voronoi) areas make the exitance of a uniformly lit plane exact in the mean:
+/// marble (the default scene's material) at the default scene's sample density, normal
+/// incidence, two seeds at 24² pixels over the middle 2 units. With equal areas (total / N)
+/// the plane's border holds more samples than its share and every method sat 0.37–0.44% low;
+/// the per-pixel noise of the split methods' global sum falls to about 0.4 of what it was.
+/// The split methods compute the local term with exact K at every point
+/// (`exact_local_integral`), and the clusters use ε = 0.05 (ε = 0.5 adds a −0.25% cluster
+/// error that hierarchical shares), so what is measured is the quadrature of the sums.
 #[test]
-fn voronoi_areas_make_a_uniform_plane_exact_for_the_split_methods() {
+fn voronoi_areas_make_a_uniform_plane_exact() {
     use uniform_plane::*;
-    let m = marble();
+    // 16 units: the tail of Rd beyond 7 units from the view is below 1e-4 of Rd_total.
+    let m = Material {
+        size: 16.0,
+        ..marble()
+    };
     for method in ["local-global", "edge-aware"] {
-        let (mut bias, mut noise, mut equal_noise) = (Vec3::ZERO, 0.0f32, 0.0f32);
+        let (mut bias, mut equal_bias, mut noise, mut equal_noise) =
+            (Vec3::ZERO, Vec3::ZERO, 0.0f32, 0.0f32);
         let seeds = [1, 2];
         for seed in seeds {
-            let scene = scene(&m, 0.0, method, 24, seed);
-            let v = measure(&scene, &m, false, true);
-            let e = measure(&scene, &m, true, true);
+            let (v, e) = measure(&scene(&m, 0.0, method, 0.05, 24, seed), &m, true);
             bias += v.bias / seeds.len() as f32;
+            equal_bias += e.bias / seeds.len() as f32;
             noise = noise.max(v.noise.max_element());
             equal_noise = equal_noise.max(e.noise.max_element());
         }
-        let bias = worst(bias);
-        assert!(bias.abs() < 0.002, "{method}: mean exitance off by {:.3}%", bias * 100.0);
-        assert!(noise < 0.005, "{method}: per-pixel noise {:.3}%", noise * 100.0);
+        let (bias, equal_bias) = (worst(bias), worst(equal_bias));
         assert!(
-            noise < 0.5 * equal_noise,
+            bias.abs() < 0.002,
+            "{method}: mean exitance off by {:.3}%",
+            bias * 100.0
+        );
+        assert!(
+            equal_bias < -0.002,
+            "{method}: equal areas {:.3}%: the test no longer sees the border bias",
+            equal_bias * 100.0
+        );
+        assert!(
+            noise < 0.015 && noise < 0.5 * equal_noise,
             "{method}: noise {:.3}% with Voronoi areas, {:.3}% with equal areas",
             noise * 100.0,
             equal_noise * 100.0
@@ -458,11 +481,17 @@ fn voronoi_areas_make_a_uniform_plane_exact_for_the_split_methods() {
 
 /// The full before/after table (slow: run with `--ignored --nocapture`): every method, three
 /// materials, normal and 60° incidence, equal and Voronoi areas, at 64² pixels and the default
-/// scene's sample density, means over seeds.
+/// scene's sample density, means over seeds. `LUCENT_SEEDS=n` (default 3), `LUCENT_EPSILON`
+/// (default 0.5), `LUCENT_ONLY=method,…` (or material names; default all).
 #[test]
 #[ignore]
 fn uniform_plane_table() {
     use uniform_plane::*;
+    let only = std::env::var("LUCENT_ONLY").unwrap_or_default();
+    let epsilon: f32 = std::env::var("LUCENT_EPSILON")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.5);
     let seeds: Vec<u64> = std::env::var("LUCENT_SEEDS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -478,22 +507,27 @@ fn uniform_plane_table() {
         (kd_ell(), 0.0),
     ] {
         for method in ["local-global", "edge-aware", "hierarchical", "exhaustive"] {
+            if !only.is_empty() && !only.split(',').any(|o| o == method || o == m.name) {
+                continue;
+            }
             for exact in [true, false] {
                 let split = method == "local-global" || method == "edge-aware";
                 if !split && !exact {
                     continue;
                 }
-                for equal in [true, false] {
-                    let mut sum = Outcome::default();
-                    let mut noise = Vec3::ZERO;
-                    for &seed in &seeds {
-                        let o = measure(&scene(&m, incidence, method, 64, seed), &m, equal, exact);
-                        let k = seeds.len() as f32;
+                let (mut voronoi, mut equal) = (Outcome::default(), Outcome::default());
+                for &seed in &seeds {
+                    let scene = scene(&m, incidence, method, epsilon, 64, seed);
+                    let (v, e) = measure(&scene, &m, exact);
+                    let k = seeds.len() as f32;
+                    for (sum, o) in [(&mut voronoi, v), (&mut equal, e)] {
                         sum.bias += o.bias / k;
                         sum.local += o.local / k;
                         sum.global += o.global / k;
-                        noise += o.noise / k;
+                        sum.noise += o.noise / k;
                     }
+                }
+                for (label, sum) in [("equal", equal), ("Voronoi", voronoi)] {
                     let k = if !split {
                         ""
                     } else if exact {
@@ -504,9 +538,9 @@ fn uniform_plane_table() {
                     println!(
                         "| {} | {incidence}° | {method}{k} | {} | {:+.3} | {:.3} | {:.2} | {:.2} |",
                         m.name,
-                        if equal { "equal" } else { "Voronoi" },
+                        label,
                         worst(sum.bias) * 100.0,
-                        noise.max_element() * 100.0,
+                        sum.noise.max_element() * 100.0,
                         sum.local.x * 100.0,
                         sum.global.x * 100.0,
                     );

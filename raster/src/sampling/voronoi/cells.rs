@@ -130,13 +130,14 @@ impl Cells {
     /// Distance from `p` (in the cell at coordinates `c`) to the boundary of the block of cells
     /// within `k` of `c`: every site closer than that to `p` is in [`Cells::gather`]'s block.
     pub(super) fn block_margin(&self, p: DVec3, c: [i64; 3], k: i64) -> f64 {
-        (0..3).fold(f64::INFINITY, |m, a| {
-            let lo = self.origin[a] + (c[a] - k) as f64 * self.size;
-            let hi = self.origin[a] + (c[a] + k + 1) as f64 * self.size;
-            m.min(p[a] - lo).min(hi - p[a])
-        })
-        // Never below the guaranteed k cells (rounding in the box).
-        .max(k as f64 * self.size)
+        (0..3)
+            .fold(f64::INFINITY, |m, a| {
+                let lo = self.origin[a] + (c[a] - k) as f64 * self.size;
+                let hi = self.origin[a] + (c[a] + k + 1) as f64 * self.size;
+                m.min(p[a] - lo).min(hi - p[a])
+            })
+            // Never below the guaranteed k cells (rounding in the box).
+            .max(k as f64 * self.size)
     }
 
     /// Sorted site range of occupied cell `c`.
@@ -198,7 +199,12 @@ impl Cells {
     /// no larger than a cell (recursive longest-edge bisection), and each piece goes to the
     /// occupied cells its bounding box, grown by `reach`, overlaps. `live[t]` is false for
     /// triangles without area, which no cell gets.
-    pub(super) fn register_triangles(&mut self, triangles: &[[Vec3; 3]], live: &[bool], reach: f64) {
+    pub(super) fn register_triangles(
+        &mut self,
+        triangles: &[[Vec3; 3]],
+        live: &[bool],
+        reach: f64,
+    ) {
         let lists: Vec<Vec<u32>> = triangles
             .par_iter()
             .enumerate()

@@ -302,7 +302,11 @@ mod tests {
 
     #[test]
     fn an_unclipped_triangle_keeps_its_area_and_a_bisector_halves_a_square_cell() {
-        let t = [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0)];
+        let t = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ];
         let f = Frame::new(&t).unwrap();
         let mut p = Polygon::default();
         let site = DVec3::new(0.5, 0.5, 0.0);
@@ -356,7 +360,10 @@ mod tests {
                 }
             }
             let d = distance2_to_triangle(p, &t);
-            assert!(d <= best + 1e-12 && best.sqrt() - d.sqrt() < 4e-3, "{d} {best}");
+            assert!(
+                d <= best + 1e-12 && best.sqrt() - d.sqrt() < 4e-3,
+                "{d} {best}"
+            );
         }
     }
 }

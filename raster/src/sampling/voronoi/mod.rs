@@ -74,7 +74,7 @@ use clip::{Frame, Neighbour, Outcome, Polygon, distance2_to_triangle};
 /// Grid cell edge, in hexagonal-packing spacings. A cell's 3×3×3 block guarantees every
 /// neighbour within one cell edge, which proves cells whose farthest vertex is within 0.75
 /// spacings (a hexagonal cell's is 0.58).
-const CELL: f64 = 1.5;
+const CELL: f64 = 2.0;
 /// A site processes the triangles within this many spacings. The nearest sample of any surface
 /// point is nearly always closer than this (0.58 for hexagonal packing); where it is not, the
 /// triangle is redone with a wider reach.
@@ -134,9 +134,11 @@ pub fn voronoi_areas(triangles: &[[Vec3; 3]], sites: &[Vec3]) -> VoronoiAreas {
     let points: Vec<Vec3> = finite.iter().map(|&i| sites[i as usize]).collect();
     let sorted = if total > 0.0 {
         let spacing = hex_spacing(total, points.len().min(u32::MAX as usize) as u32) as f64;
-        let (lo, hi) = points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
-            (l.min(p), h.max(p))
-        });
+        let (lo, hi) = points
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
+                (l.min(p), h.max(p))
+            });
         // Cells no smaller than 1/2²⁰ of the extent, so that no site's coordinate is clamped.
         let extent = (hi - lo).max_element() as f64;
         let size = (CELL * spacing).max(extent / (1 << 20) as f64);
@@ -195,7 +197,9 @@ impl Pass<'_> {
     fn run(&self) -> (Vec<f32>, VoronoiStats) {
         let cells = self.cells;
         let n = cells.sites.len();
-        let flags: Vec<AtomicU8> = (0..self.triangles.len()).map(|_| AtomicU8::new(0)).collect();
+        let flags: Vec<AtomicU8> = (0..self.triangles.len())
+            .map(|_| AtomicU8::new(0))
+            .collect();
         let (clipped, widened, shared) = (AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0));
         let mut areas = vec![0.0f32; n];
         // Tasks of CELLS_PER_TASK cells, each with its slice of the output.
@@ -285,7 +289,14 @@ impl Pass<'_> {
             let ps = cells.sites[s].as_dvec3();
             let guaranteed = cells.block_margin(ps, home, 1);
             let mut neighbours = std::mem::take(&mut scratch.neighbours);
-            self.sorted_neighbours(s, ps, &scratch.block, guaranteed, &mut neighbours, &mut scratch.far);
+            self.sorted_neighbours(
+                s,
+                ps,
+                &scratch.block,
+                guaranteed,
+                &mut neighbours,
+                &mut scratch.far,
+            );
             counts[2] += neighbours.iter().take_while(|n| n.0 == 0.0).count().min(1) as u64;
             let mut area = 0.0;
             for &t in triangles {

@@ -66,8 +66,8 @@ fn areas_sum_to_the_surface_area() {
         }
     }
     // The bunny: 3674 triangles of very different sizes, thin ears.
-    let bunny = crate::scene::obj::parse_obj(include_bytes!("../../../../assets/bunny.obj"))
-        .unwrap();
+    let bunny =
+        crate::scene::obj::parse_obj(include_bytes!("../../../../assets/bunny.obj")).unwrap();
     let tris: Vec<[Vec3; 3]> = bunny
         .triangles
         .iter()
@@ -143,8 +143,14 @@ fn matches_a_brute_force_oracle_within_its_discretisation_error() {
     let (coarse, fine) = (errors(16), errors(64));
     let edge = 3.0 / 2.0 / 64.0; // the plane's triangles are the largest: 1.5 units
     let bound = 4.0 * mean.sqrt() * edge / mean;
-    assert!(fine < bound, "max error {fine} of the mean area, bound {bound}");
-    assert!(fine < 0.5 * coarse, "error does not fall: {coarse} → {fine}");
+    assert!(
+        fine < bound,
+        "max error {fine} of the mean area, bound {bound}"
+    );
+    assert!(
+        fine < 0.5 * coarse,
+        "error does not fall: {coarse} → {fine}"
+    );
 }
 
 #[test]
