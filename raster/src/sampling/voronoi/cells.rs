@@ -54,10 +54,12 @@ fn unpack(k: u64) -> [i64; 3] {
 }
 
 impl Cells {
-    /// Sorts `sites` (all finite) into cells of edge `size`.
+    /// Sorts the finite ones of `sites` into cells of edge `size` (`order` then maps sorted
+    /// sites to input indices).
     pub(super) fn new(sites: &[Vec3], size: f64) -> Cells {
         let origin = sites
             .iter()
+            .filter(|p| p.is_finite())
             .fold(Vec3::splat(f32::INFINITY), |m, &p| m.min(p))
             .as_dvec3();
         let mut cells = Cells {
@@ -73,23 +75,36 @@ impl Cells {
             tri_start: Vec::new(),
             tris: Vec::new(),
         };
+        // An indexed collect writes in place (a filtered one would gather pieces and copy
+        // them, twice the memory); non-finite sites get a key above every cell's and are cut
+        // off after the sort.
         let mut keyed: Vec<(u64, u32)> = sites
             .par_iter()
             .enumerate()
-            .map(|(i, p)| (pack(cells.coords(p.as_dvec3())), i as u32))
+            .map(|(i, p)| {
+                let key = if p.is_finite() {
+                    pack(cells.coords(p.as_dvec3()))
+                } else {
+                    u64::MAX
+                };
+                (key, i as u32)
+            })
             .collect();
         // Keys with their index are unique, so the unstable sort is deterministic.
         keyed.par_sort_unstable();
-        cells.order = keyed.iter().map(|&(_, i)| i).collect();
-        cells.sites = keyed.iter().map(|&(_, i)| sites[i as usize]).collect();
+        keyed.truncate(keyed.partition_point(|&(k, _)| k != u64::MAX));
         for (k, &(key, _)) in keyed.iter().enumerate() {
             if cells.cell_key.last() != Some(&key) {
                 cells.cell_key.push(key);
                 cells.cell_start.push(k as u32);
             }
         }
-        cells.cell_start.push(sites.len() as u32);
+        cells.cell_start.push(keyed.len() as u32);
+        // The order first and the keys dropped before the positions are gathered: the peak is
+        // 20 bytes per site, not 32.
+        cells.order = keyed.iter().map(|&(_, i)| i).collect();
         drop(keyed);
+        cells.sites = cells.order.iter().map(|&i| sites[i as usize]).collect();
         let bits = (cells.cell_key.len() * 2)
             .max(2)
             .next_power_of_two()

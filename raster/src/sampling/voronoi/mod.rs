@@ -118,12 +118,6 @@ pub fn voronoi_areas(triangles: &[[Vec3; 3]], sites: &[Vec3]) -> VoronoiAreas {
         areas: vec![0.0; sites.len()],
         stats: VoronoiStats::default(),
     };
-    let finite: Vec<u32> = (0..sites.len() as u32)
-        .filter(|&i| sites[i as usize].is_finite())
-        .collect();
-    if finite.is_empty() {
-        return out;
-    }
     let live: Vec<bool> = triangles.iter().map(|t| Frame::new(t).is_some()).collect();
     let total: f64 = triangles
         .iter()
@@ -131,44 +125,41 @@ pub fn voronoi_areas(triangles: &[[Vec3; 3]], sites: &[Vec3]) -> VoronoiAreas {
         .filter(|&(_, &l)| l)
         .map(|(t, _)| triangle_area(t))
         .sum();
-    let points: Vec<Vec3> = finite.iter().map(|&i| sites[i as usize]).collect();
-    let sorted = if total > 0.0 {
-        let spacing = hex_spacing(total, points.len().min(u32::MAX as usize) as u32) as f64;
-        let (lo, hi) = points
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
-                (l.min(p), h.max(p))
-            });
-        // Cells no smaller than 1/2²⁰ of the extent, so that no site's coordinate is clamped.
-        let extent = (hi - lo).max_element() as f64;
-        let size = (CELL * spacing).max(extent / (1 << 20) as f64);
-        let reach = REACH / CELL * size;
-        let mut cells = Cells::new(&points, size);
-        // Registration reaches a little further than the pass, so that float rounding in the
-        // boxes cannot drop a triangle a site reaches.
-        cells.register_triangles(triangles, &live, reach * 1.01);
-        let pass = Pass {
-            triangles,
-            cells: &cells,
-            reach2: reach * reach,
-        };
-        let (areas, stats) = pass.run();
-        out.stats = stats;
-        Some((cells.order, areas))
-    } else {
-        None
-    };
-    let Some((order, areas)) = sorted else {
-        for &i in &finite {
-            out.areas[i as usize] = f32::MIN_POSITIVE;
-        }
-        out.stats.empty = finite.len() as u64;
+    let (count, lo, hi) = sites.iter().filter(|p| p.is_finite()).fold(
+        (0usize, Vec3::INFINITY, Vec3::NEG_INFINITY),
+        |(n, l, h), &p| (n + 1, l.min(p), h.max(p)),
+    );
+    if count == 0 {
         return out;
+    }
+    if total <= 0.0 {
+        for (a, p) in out.areas.iter_mut().zip(sites) {
+            if p.is_finite() {
+                *a = f32::MIN_POSITIVE;
+            }
+        }
+        out.stats.empty = count as u64;
+        return out;
+    }
+    let spacing = hex_spacing(total, count.min(u32::MAX as usize) as u32) as f64;
+    // Cells no smaller than 1/2²⁰ of the extent, so that no site's coordinate is clamped.
+    let extent = (hi - lo).max_element() as f64;
+    let size = (CELL * spacing).max(extent / (1 << 20) as f64);
+    let reach = REACH / CELL * size;
+    let mut cells = Cells::new(sites, size);
+    // Registration reaches a little further than the pass, so that float rounding in the
+    // boxes cannot drop a triangle a site reaches.
+    cells.register_triangles(triangles, &live, reach * 1.01);
+    let pass = Pass {
+        triangles,
+        cells: &cells,
+        reach2: reach * reach,
     };
-    for (&k, &a) in order.iter().zip(&areas) {
-        let i = finite[k as usize] as usize;
+    let (areas, stats) = pass.run();
+    out.stats = stats;
+    for (&i, &a) in cells.order.iter().zip(&areas) {
         out.stats.empty += (a <= 0.0) as u64;
-        out.areas[i] = a.max(f32::MIN_POSITIVE);
+        out.areas[i as usize] = a.max(f32::MIN_POSITIVE);
     }
     out
 }
