@@ -139,10 +139,15 @@ fn matches_a_brute_force_oracle_within_its_discretisation_error() {
             .fold(0.0, f64::max)
     };
     // A misassigned sub-triangle lies on a cell's boundary: the error is at most the cell's
-    // perimeter (≈ 4√mean) times a sub-triangle's size, and it falls as that does.
+    // perimeter (≈ 4√mean) times a sub-triangle's size, and it falls as that does. Errors on
+    // the two sides of a boundary mostly cancel, so a quarter of that bound is asserted
+    // (measured: 4.1e-2 of the mean area at 16², 1.05e-2 at 64², against 4.0e-2).
     let (coarse, fine) = (errors(16), errors(64));
     let edge = 3.0 / 2.0 / 64.0; // the plane's triangles are the largest: 1.5 units
-    let bound = 4.0 * mean.sqrt() * edge / mean;
+    let bound = mean.sqrt() * edge / mean;
+    println!(
+        "oracle: max error {coarse:.2e} (16²), {fine:.2e} (64²) of the mean area, bound {bound:.2e}"
+    );
     assert!(
         fine < bound,
         "max error {fine} of the mean area, bound {bound}"
