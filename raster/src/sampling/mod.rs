@@ -14,7 +14,7 @@
 //! scene's density (64² pixels over its middle, 3 seeds), the exhaustive sum sat 0.44% below
 //! E·Rd_total with equal areas and is within 0.02% with Voronoi areas; the split methods'
 //! per-pixel noise fell from 2.6% to 1.1% (skin: 4.4% → 2.7%). Cost: about 1.7 µs of CPU per
-//! sample (1M samples on the bunny: 1.7 s CPU) and under 30 bytes per sample of transient
+//! sample (1M samples on the bunny: 1.7 s CPU) and at most 33 bytes per sample of transient
 //! memory; the areas sum to each object's area to 1e-10 relative.
 //! [`stratified_square`] gives the per-pixel sample patterns for area-light soft shadows.
 //!

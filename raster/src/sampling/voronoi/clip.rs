@@ -106,18 +106,21 @@ pub(super) enum Outcome {
     NeedMore(f64),
 }
 
-/// A site's neighbours, nearest first: squared distance, sorted index, position.
-pub(super) type Neighbour = (f64, u32, DVec3);
+/// A site's neighbour: squared distance and sorted index.
+pub(super) type Neighbour = (f64, u32);
 
 impl Polygon {
     /// The cell of `site` restricted to the triangle of `frame`, clipped by `neighbours`
-    /// (nearest first; coincident ones are skipped, the caller shares their cell). Every site
-    /// closer than `guaranteed` (a distance) must be in the list.
+    /// (indices into `sites`; coincident ones are skipped, the caller shares their cell). The
+    /// list holds, nearest first, every site closer than `sorted`, then others farther than
+    /// that in any order; every site closer than `guaranteed` (≥ `sorted`) is in it.
     pub(super) fn clip_cell(
         &mut self,
         frame: &Frame,
         site: DVec3,
+        sites: &[Vec3],
         neighbours: &[Neighbour],
+        sorted: f64,
         guaranteed: f64,
     ) -> Outcome {
         let f = frame;
@@ -128,16 +131,26 @@ impl Polygon {
         self.label[..3].fill(TRIANGLE_EDGE);
         let s = site - f.origin;
         let (su, sv, h) = (s.dot(f.e1), s.dot(f.e2), s.dot(f.normal));
-        let g2 = guaranteed * guaranteed;
+        let (s2, g2) = (sorted * sorted, guaranteed * guaranteed);
         let mut r2 = self.vertex_radius2(su, sv, h * h);
         self.r2 = r2;
-        for &(d2, j, pj) in neighbours {
+        for &(d2, j) in neighbours {
             if d2 == 0.0 {
                 continue;
             }
-            if 4.0 * r2 <= d2.min(g2) {
+            if 4.0 * r2 <= d2 {
+                if d2 <= s2 {
+                    // Sorted: every later neighbour, and every unlisted site, is as far.
+                    return Outcome::Done;
+                }
+                // Unsorted: this one cannot cut; a later one might be nearer.
+                continue;
+            }
+            if d2 > s2 && 4.0 * r2 <= s2 {
+                // Every site within `sorted` is done and the rest are farther.
                 return Outcome::Done;
             }
+            let pj = sites[j as usize].as_dvec3();
             let d = pj - site;
             let m = pj + site - 2.0 * f.origin;
             let (a, b, c) = (2.0 * d.dot(f.e1), 2.0 * d.dot(f.e2), d.dot(m));
@@ -311,27 +324,32 @@ mod tests {
         let mut p = Polygon::default();
         let site = DVec3::new(0.5, 0.5, 0.0);
         // Nobody within 10: the whole triangle.
-        assert_eq!(p.clip_cell(&f, site, &[], 10.0), Outcome::Done);
+        assert_eq!(p.clip_cell(&f, site, &[], &[], 10.0, 10.0), Outcome::Done);
         assert!((p.area() - 2.0).abs() < 1e-12);
-        // A neighbour at (1.5, 0.5), 0.3 above the plane: in the plane its bisector is shifted
-        // away from it by the squared height over twice the distance, x = 1 + 0.09/2.
-        let j = DVec3::new(1.5, 0.5, 0.3);
-        let n = [(site.distance_squared(j), 0, j)];
-        assert_eq!(p.clip_cell(&f, site, &n, 10.0), Outcome::Done);
-        let x = 1.0 + 0.09 / 2.0;
+        // A neighbour at (1.5, 0.5), 0.25 above the plane: in the plane its bisector is
+        // shifted away from it by the squared height over twice the distance, x = 1 + 0.0625/2.
+        let j = DVec3::new(1.5, 0.5, 0.25);
+        let sites = [j.as_vec3()];
+        let n = [(site.distance_squared(j), 0)];
+        assert_eq!(p.clip_cell(&f, site, &sites, &n, 10.0, 10.0), Outcome::Done);
+        let x = 1.0 + 0.0625 / 2.0;
         let want = 2.0 - (2.0 - x) * (2.0 - x) / 2.0;
         assert!((p.area() - want).abs() < 1e-12, "{} vs {want}", p.area());
         assert_eq!(p.bisector_labels().collect::<Vec<_>>(), vec![0]);
         // Without the guarantee, the cell is not proven.
         assert!(matches!(
-            p.clip_cell(&f, site, &n, 0.1),
+            p.clip_cell(&f, site, &sites, &n, 0.1, 0.1),
             Outcome::NeedMore(_)
         ));
         // A neighbour that takes everything.
         let far = DVec3::new(-5.0, -5.0, 0.0);
         let close = DVec3::new(0.6, 0.6, 0.0);
-        let n = [(far.distance_squared(close), 1, close)];
-        assert_eq!(p.clip_cell(&f, far, &n, 100.0), Outcome::Empty);
+        let sites = [Vec3::ZERO, close.as_vec3()];
+        let n = [(far.distance_squared(close), 1)];
+        assert_eq!(
+            p.clip_cell(&f, far, &sites, &n, 100.0, 100.0),
+            Outcome::Empty
+        );
     }
 
     #[test]
