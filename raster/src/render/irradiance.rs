@@ -2,8 +2,13 @@
 //! irradiance from the lights (with shadows), and one irradiance cache per translucent object.
 //!
 //! One Poisson-disk set covers all translucent triangles together, so every object gets the
-//! same spacing and every sample the same area (total area / N, unbiased; reference sheet §4).
-//! Caches are per object: light does not diffuse from one object into another.
+//! same spacing. Each sample's area is its own share of its object's surface, its cell of the
+//! restricted Voronoi diagram ([`voronoi_areas`]): the areas of an object sum to its surface
+//! area, and a sample that stands closer to its neighbours weighs less, so the density
+//! fluctuations of the blue noise and the denser samples near a surface's border do not become
+//! exitance error as they did with equal areas (total / N, reference sheet §4). Cells are per
+//! object (a sample never takes area of another object), and so are the caches: light does not
+//! diffuse from one object into another.
 
 use glam::Vec3;
 use lucent_core::{IrradianceCache, Sample};
@@ -13,7 +18,7 @@ use super::RenderError;
 use super::prepare::Prepared;
 use crate::lights::{Lighting, ShadowHints};
 use crate::sampling::rng::splitmix64;
-use crate::sampling::{SampleTarget, poisson_samples, total_area};
+use crate::sampling::{SampleTarget, poisson_samples, voronoi_areas};
 use crate::scene::SampleDensity;
 
 /// The samples on one translucent object.
@@ -25,7 +30,8 @@ pub struct ObjectSamples {
     pub positions: Vec<Vec3>,
     /// Unit shading normals.
     pub normals: Vec<Vec3>,
-    /// Areas (scene units²).
+    /// Areas (scene units²): each sample's cell of the restricted Voronoi diagram of its
+    /// object's samples, so they sum to the object's surface area.
     pub areas: Vec<f32>,
     /// Irradiance (filled when the samples are lit).
     pub irradiance: Vec<Vec3>,
@@ -68,7 +74,6 @@ pub fn place_samples(
         SampleDensity::Spacing(s) => SampleTarget::Spacing(s),
     };
     let points = poisson_samples(&triangles, target, seed).map_err(RenderError::Sampling)?;
-    let area = (total_area(&triangles) / points.len().max(1) as f64) as f32;
 
     let mut sets: Vec<ObjectSamples> = objects
         .iter()
@@ -90,9 +95,15 @@ pub fn place_samples(
         let n = (0..3).fold(Vec3::ZERO, |n, k| n + mesh.normals[tri[k] as usize] * b[k]);
         set.positions.push(p.position);
         set.normals.push(n.normalize_or(Vec3::Z));
-        set.areas.push(area);
     }
     sets.retain(|s| !s.is_empty());
+    for set in &mut sets {
+        let (a, b) = (
+            prep.first_triangle[set.object] as usize,
+            prep.first_triangle[set.object + 1] as usize,
+        );
+        set.areas = voronoi_areas(&prep.triangles[a..b], &set.positions).areas;
+    }
     Ok(sets)
 }
 

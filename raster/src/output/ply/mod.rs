@@ -1,7 +1,8 @@
 //! The baked irradiance sample set: a binary PLY point cloud.
 //!
 //! `lucent bake` writes the irradiance samples (position, normal, the surface area each one
-//! represents, and the irradiance there) so that `lucent render` can load them instead of
+//! represents — its cell of the restricted Voronoi diagram of its object's samples, so an
+//! object's areas sum to its surface area — and the irradiance there) so that `lucent render` can load them instead of
 //! sampling and lighting again, and so that they can be inspected in any point-cloud viewer.
 //!
 //! # Format
@@ -99,7 +100,8 @@ pub struct SampleSet {
     pub positions: Vec<Vec3>,
     /// Unit surface normals.
     pub normals: Vec<Vec3>,
-    /// Surface area each sample represents (scene units²).
+    /// Surface area each sample represents (scene units²): its restricted Voronoi cell when
+    /// placed by lucent; any non-negative weights when read from a file.
     pub areas: Vec<f32>,
     /// Irradiance at each sample (linear RGB).
     pub irradiance: Vec<Vec3>,

@@ -1,0 +1,325 @@
+//! The sites sorted into a sparse uniform grid, and for each occupied cell the triangles that
+//! its sites may take area from.
+//!
+//! ```text
+//! sites:       positions sorted by cell key (x-major), `order[k]` = input index of site k
+//! cell_key:    [k0, k1, …]          occupied cells, ascending key
+//! cell_start:  [0, 3, 7, …, N]      sites of cell c: cell_start[c] .. cell_start[c + 1]
+//! slots:       open addressing, key → cell index (u32::MAX empty), 2× the cells
+//! tri_start:   [0, 2, 5, …]         triangles of cell c: tris[tri_start[c] .. tri_start[c + 1]],
+//! tris:        [t, t, …]            ascending
+//! ```
+//!
+//! About 23 bytes per site (12 position, 4 order, ~7 cells and slots) plus 4 per (cell,
+//! triangle) pair, about one pair per site on a mesh with fewer triangles than samples.
+
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+/// Bits per axis of a packed cell key. Coordinates are clamped to `0 .. 2²¹`; clamping is
+/// monotone, so sites closer than a cell still fall in the same or adjacent cells.
+const AXIS_BITS: u32 = 21;
+const AXIS_MAX: i64 = (1 << AXIS_BITS) - 1;
+const EMPTY: u32 = u32::MAX;
+
+/// The grid (see the module documentation).
+pub(super) struct Cells {
+    origin: DVec3,
+    /// Cell edge length.
+    pub(super) size: f64,
+    inv: f64,
+    /// Site positions in cell order.
+    pub(super) sites: Vec<Vec3>,
+    /// Input index of each sorted site.
+    pub(super) order: Vec<u32>,
+    cell_key: Vec<u64>,
+    cell_start: Vec<u32>,
+    slots: Vec<u32>,
+    shift: u32,
+    tri_start: Vec<u32>,
+    tris: Vec<u32>,
+}
+
+fn pack(c: [i64; 3]) -> u64 {
+    ((c[0] as u64) << (2 * AXIS_BITS)) | ((c[1] as u64) << AXIS_BITS) | c[2] as u64
+}
+
+fn unpack(k: u64) -> [i64; 3] {
+    let m = AXIS_MAX as u64;
+    [
+        (k >> (2 * AXIS_BITS)) as i64,
+        ((k >> AXIS_BITS) & m) as i64,
+        (k & m) as i64,
+    ]
+}
+
+impl Cells {
+    /// Sorts the finite ones of `sites` into cells of edge `size` (`order` then maps sorted
+    /// sites to input indices).
+    pub(super) fn new(sites: &[Vec3], size: f64) -> Cells {
+        let origin = sites
+            .iter()
+            .filter(|p| p.is_finite())
+            .fold(Vec3::splat(f32::INFINITY), |m, &p| m.min(p))
+            .as_dvec3();
+        let mut cells = Cells {
+            origin,
+            size,
+            inv: 1.0 / size.max(f64::MIN_POSITIVE),
+            sites: Vec::new(),
+            order: Vec::new(),
+            cell_key: Vec::new(),
+            cell_start: Vec::new(),
+            slots: Vec::new(),
+            shift: 0,
+            tri_start: Vec::new(),
+            tris: Vec::new(),
+        };
+        // An indexed collect writes in place (a filtered one would gather pieces and copy
+        // them, twice the memory); non-finite sites get a key above every cell's and are cut
+        // off after the sort.
+        let mut keyed: Vec<(u64, u32)> = sites
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let key = if p.is_finite() {
+                    pack(cells.coords(p.as_dvec3()))
+                } else {
+                    u64::MAX
+                };
+                (key, i as u32)
+            })
+            .collect();
+        // Keys with their index are unique, so the unstable sort is deterministic.
+        keyed.par_sort_unstable();
+        keyed.truncate(keyed.partition_point(|&(k, _)| k != u64::MAX));
+        for (k, &(key, _)) in keyed.iter().enumerate() {
+            if cells.cell_key.last() != Some(&key) {
+                cells.cell_key.push(key);
+                cells.cell_start.push(k as u32);
+            }
+        }
+        cells.cell_start.push(keyed.len() as u32);
+        // The order first and the keys dropped before the positions are gathered: the peak is
+        // 20 bytes per site, not 32.
+        cells.order = keyed.iter().map(|&(_, i)| i).collect();
+        drop(keyed);
+        cells.sites = cells.order.iter().map(|&i| sites[i as usize]).collect();
+        let bits = (cells.cell_key.len() * 2)
+            .max(2)
+            .next_power_of_two()
+            .trailing_zeros();
+        cells.slots = vec![EMPTY; 1 << bits];
+        cells.shift = 64 - bits;
+        let mask = cells.slots.len() - 1;
+        for (c, &key) in cells.cell_key.iter().enumerate() {
+            let mut s = cells.slot(key);
+            while cells.slots[s] != EMPTY {
+                s = (s + 1) & mask;
+            }
+            cells.slots[s] = c as u32;
+        }
+        cells
+    }
+
+    /// Number of occupied cells.
+    pub(super) fn len(&self) -> usize {
+        self.cell_key.len()
+    }
+
+    /// Clamped cell coordinates of a point.
+    pub(super) fn coords(&self, p: DVec3) -> [i64; 3] {
+        let c = |x: f64, o: f64| ((x - o) * self.inv).floor().clamp(0.0, AXIS_MAX as f64) as i64;
+        [
+            c(p.x, self.origin.x),
+            c(p.y, self.origin.y),
+            c(p.z, self.origin.z),
+        ]
+    }
+
+    /// Coordinates of occupied cell `c`.
+    pub(super) fn cell_coords(&self, c: usize) -> [i64; 3] {
+        unpack(self.cell_key[c])
+    }
+
+    /// Distance from `p` (in the cell at coordinates `c`) to the boundary of the block of cells
+    /// within `k` of `c`: every site closer than that to `p` is in [`Cells::gather`]'s block.
+    pub(super) fn block_margin(&self, p: DVec3, c: [i64; 3], k: i64) -> f64 {
+        (0..3)
+            .fold(f64::INFINITY, |m, a| {
+                let lo = self.origin[a] + (c[a] - k) as f64 * self.size;
+                let hi = self.origin[a] + (c[a] + k + 1) as f64 * self.size;
+                m.min(p[a] - lo).min(hi - p[a])
+            })
+            // Never below the guaranteed k cells (rounding in the box).
+            .max(k as f64 * self.size)
+    }
+
+    /// Sorted site range of occupied cell `c`.
+    pub(super) fn sites_of(&self, c: usize) -> std::ops::Range<usize> {
+        self.cell_start[c] as usize..self.cell_start[c + 1] as usize
+    }
+
+    /// The triangles registered with occupied cell `c`, ascending.
+    pub(super) fn triangles_of(&self, c: usize) -> &[u32] {
+        &self.tris[self.tri_start[c] as usize..self.tri_start[c + 1] as usize]
+    }
+
+    fn slot(&self, key: u64) -> usize {
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> self.shift) as usize
+    }
+
+    /// The occupied cell at clamped coordinates `c`, if any.
+    pub(super) fn find(&self, c: [i64; 3]) -> Option<usize> {
+        if c.iter().any(|&x| !(0..=AXIS_MAX).contains(&x)) {
+            return None;
+        }
+        let key = pack(c);
+        let mask = self.slots.len() - 1;
+        let mut s = self.slot(key);
+        loop {
+            let cell = self.slots[s];
+            if cell == EMPTY {
+                return None;
+            }
+            if self.cell_key[cell as usize] == key {
+                return Some(cell as usize);
+            }
+            s = (s + 1) & mask;
+        }
+    }
+
+    /// Appends the sorted indices of the sites in the cells within `k` cells of `c` (per axis),
+    /// in key order; if that block would visit more cells than are occupied, every site. Every
+    /// site closer than `k · size` to a point of cell `c` is included.
+    pub(super) fn gather(&self, c: [i64; 3], k: i64, out: &mut Vec<u32>) {
+        let side = (2 * k + 1) as f64;
+        if side * side * side >= self.len() as f64 {
+            out.extend(0..self.sites.len() as u32);
+            return;
+        }
+        for x in c[0] - k..=c[0] + k {
+            for y in c[1] - k..=c[1] + k {
+                for z in c[2] - k..=c[2] + k {
+                    if let Some(cell) = self.find([x, y, z]) {
+                        out.extend(self.sites_of(cell).map(|i| i as u32));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Registers with every occupied cell the triangles that come within `reach` (≤ the cell
+    /// size) of a point of the cell, and perhaps a few more: each triangle is cut into pieces
+    /// no larger than a cell (recursive longest-edge bisection), and each piece goes to the
+    /// occupied cells its bounding box, grown by `reach`, overlaps. `live[t]` is false for
+    /// triangles without area, which no cell gets.
+    pub(super) fn register_triangles(
+        &mut self,
+        triangles: &[[Vec3; 3]],
+        live: &[bool],
+        reach: f64,
+    ) {
+        let lists: Vec<Vec<u32>> = triangles
+            .par_iter()
+            .enumerate()
+            .map(|(t, tri)| {
+                let mut cells = Vec::new();
+                if live[t] {
+                    self.cells_near(tri, reach, &mut cells);
+                    cells.sort_unstable();
+                    cells.dedup();
+                    cells.shrink_to_fit();
+                }
+                cells
+            })
+            .collect();
+        // Counting sort by cell; triangles are visited in index order, so each cell's list
+        // comes out ascending.
+        let mut start = vec![0u32; self.len() + 1];
+        for list in &lists {
+            for &c in list {
+                start[c as usize + 1] += 1;
+            }
+        }
+        for c in 0..self.len() {
+            start[c + 1] += start[c];
+        }
+        let mut tris = vec![0u32; start[self.len()] as usize];
+        let mut next = start.clone();
+        for (t, list) in lists.iter().enumerate() {
+            for &c in list {
+                tris[next[c as usize] as usize] = t as u32;
+                next[c as usize] += 1;
+            }
+        }
+        self.tris = tris;
+        self.tri_start = start;
+    }
+
+    /// For a walk over the occupied cells in key order: the index of the first occupied cell
+    /// with key ≥ that of coordinates `c` (clamped into the grid), from a cursor that only moves
+    /// forward (`from`).
+    pub(super) fn seek(&self, c: [i64; 3], from: usize) -> usize {
+        let key = pack(c.map(|x| x.clamp(0, AXIS_MAX)));
+        let mut k = from;
+        // Short hops are the rule (the next column is close); far ones binary-search.
+        let mut step = 1;
+        while k + step < self.len() && self.cell_key[k + step] < key {
+            k += step;
+            step *= 2;
+        }
+        k + self.cell_key[k..self.len().min(k + step + 1)].partition_point(|&x| x < key)
+    }
+
+    /// The sorted site range of the occupied cells from index `first` on whose keys are at most
+    /// that of coordinates `last` (the cells of one z column, from a [`Cells::seek`] cursor).
+    pub(super) fn column_sites(&self, first: usize, last: [i64; 3]) -> (u32, u32) {
+        let key = pack(last.map(|x| x.clamp(0, AXIS_MAX)));
+        let mut end = first;
+        while end < self.len() && self.cell_key[end] <= key {
+            end += 1;
+        }
+        (self.cell_start[first], self.cell_start[end])
+    }
+
+    /// The occupied cells near a triangle (see [`Cells::register_triangles`]).
+    fn cells_near(&self, tri: &[Vec3; 3], reach: f64, out: &mut Vec<u32>) {
+        let mut stack = vec![(tri.map(|v| v.as_dvec3()), 0u32)];
+        while let Some((p, depth)) = stack.pop() {
+            let lo = p[0].min(p[1]).min(p[2]);
+            let hi = p[0].max(p[1]).max(p[2]);
+            if (hi - lo).max_element() > self.size && depth < 48 {
+                // Halve the longest edge: a sliver becomes shorter slivers (not ever more of
+                // them, as a four-way split would), so the pieces grow with length, not length².
+                let l = [0, 1, 2].map(|k| p[k].distance_squared(p[(k + 1) % 3]));
+                let k = (0..3).fold(0, |b, k| if l[k] > l[b] { k } else { b });
+                let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+                let m = (a + b) * 0.5;
+                stack.push(([a, m, c], depth + 1));
+                stack.push(([m, b, c], depth + 1));
+                continue;
+            }
+            // Only cells within `reach` of the piece's plane can hold a site within `reach`.
+            let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+            let half_diagonal = 0.5 * 3f64.sqrt() * self.size;
+            let (a, b) = (self.coords(lo - reach), self.coords(hi + reach));
+            for x in a[0]..=b[0] {
+                for y in a[1]..=b[1] {
+                    for z in a[2]..=b[2] {
+                        if normal != DVec3::ZERO {
+                            let centre = self.origin
+                                + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.size;
+                            if (centre - p[0]).dot(normal).abs() > reach + half_diagonal {
+                                continue;
+                            }
+                        }
+                        if let Some(c) = self.find([x, y, z]) {
+                            out.push(c as u32);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
