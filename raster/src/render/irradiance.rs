@@ -13,7 +13,7 @@ use super::RenderError;
 use super::prepare::Prepared;
 use crate::lights::{Lighting, ShadowHints};
 use crate::sampling::rng::splitmix64;
-use crate::sampling::{SampleTarget, poisson_samples, total_area};
+use crate::sampling::{SampleTarget, poisson_samples_with_progress, total_area};
 use crate::scene::SampleDensity;
 
 /// The samples on one translucent object.
@@ -47,6 +47,7 @@ pub fn place_samples(
     prep: &Prepared,
     density: SampleDensity,
     seed: u64,
+    progress: &indicatif::ProgressBar,
 ) -> Result<Vec<ObjectSamples>, RenderError> {
     let objects = prep.translucent_objects();
     if objects.is_empty() {
@@ -67,7 +68,9 @@ pub fn place_samples(
         SampleDensity::Count(n) => SampleTarget::Count(n),
         SampleDensity::Spacing(s) => SampleTarget::Spacing(s),
     };
-    let points = poisson_samples(&triangles, target, seed).map_err(RenderError::Sampling)?;
+    let show = |done: f32| progress.set_position((done * 1000.0) as u64);
+    let points = poisson_samples_with_progress(&triangles, target, seed, &show)
+        .map_err(RenderError::Sampling)?;
     let area = (total_area(&triangles) / points.len().max(1) as f64) as f32;
 
     let mut sets: Vec<ObjectSamples> = objects

@@ -207,7 +207,10 @@ pub fn bake(scene: &Scene, progress: bool) -> Result<Vec<ObjectSamples>, RenderE
     pool.install(|| {
         let prep = Prepared::new(scene)?;
         let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
-        let mut sets = irradiance::place_samples(&prep, scene.render.samples, scene.render.seed)?;
+        let b = bar(progress, 1000, "sampling");
+        let mut sets =
+            irradiance::place_samples(&prep, scene.render.samples, scene.render.seed, &b)?;
+        b.finish_and_clear();
         let total: usize = sets.iter().map(|s| s.len()).sum();
         let b = bar(progress, total as u64, "irradiance");
         irradiance::light_samples(&prep, &mut sets, &lighting, &b);
@@ -246,7 +249,9 @@ fn render_in_pool(
         }
         None => {
             let t = Instant::now();
-            let mut sets = irradiance::place_samples(&prep, settings.samples, settings.seed)?;
+            let b = bar(options.progress, 1000, "sampling");
+            let mut sets = irradiance::place_samples(&prep, settings.samples, settings.seed, &b)?;
+            b.finish_and_clear();
             timings.sampling = t.elapsed();
             let t = Instant::now();
             let total: usize = sets.iter().map(|s| s.len()).sum();

@@ -11,7 +11,7 @@
 //! |---|---|
 //! | `rng.rs` | PCG32 and SplitMix64 (deterministic randomness) |
 //! | `surface.rs` | surface points, sample counts, area-uniform candidates |
-//! | `grid.rs` | sparse uniform grid for neighbour queries |
+//! | `grid.rs` | tiles of cells over the candidates: neighbourhoods for parallel elimination |
 //! | `maxtree.rs` | blocked tournament tree: the heaviest candidate |
 //! | `poisson.rs` | weighted sample elimination |
 //! | `stratified.rs` | stratified points in the unit square |
@@ -27,7 +27,7 @@ mod stratified;
 mod surface;
 
 pub use error::{MAX_SAMPLES, SamplingError};
-pub use poisson::poisson_samples;
+pub use poisson::{poisson_samples, poisson_samples_with_progress};
 pub use stratified::{StratifiedSquare, stratified_square};
 pub use surface::{SampleTarget, SurfacePoint, hex_spacing, total_area, triangle_area};
 
