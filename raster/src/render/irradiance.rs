@@ -18,7 +18,7 @@ use super::RenderError;
 use super::prepare::Prepared;
 use crate::lights::{Lighting, ShadowHints};
 use crate::sampling::rng::splitmix64;
-use crate::sampling::{SampleTarget, poisson_samples, voronoi_areas};
+use crate::sampling::{SampleTarget, poisson_samples_with_progress, voronoi_areas};
 use crate::scene::SampleDensity;
 
 /// The samples on one translucent object.
@@ -53,6 +53,7 @@ pub fn place_samples(
     prep: &Prepared,
     density: SampleDensity,
     seed: u64,
+    progress: &indicatif::ProgressBar,
 ) -> Result<Vec<ObjectSamples>, RenderError> {
     let objects = prep.translucent_objects();
     if objects.is_empty() {
@@ -73,7 +74,9 @@ pub fn place_samples(
         SampleDensity::Count(n) => SampleTarget::Count(n),
         SampleDensity::Spacing(s) => SampleTarget::Spacing(s),
     };
-    let points = poisson_samples(&triangles, target, seed).map_err(RenderError::Sampling)?;
+    let show = |done: f32| progress.set_position((done * 1000.0) as u64);
+    let points = poisson_samples_with_progress(&triangles, target, seed, &show)
+        .map_err(RenderError::Sampling)?;
 
     let mut sets: Vec<ObjectSamples> = objects
         .iter()

@@ -228,10 +228,12 @@ pub fn bake_planned(
         let plan = density::plan(&prep, &scene.render, None)?;
         warn_once(warn, plan.as_ref(), scene);
         let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
+        let b = bar(progress, 1000, "sampling");
         let mut sets = match &plan {
-            Some(plan) => irradiance::place_samples(&prep, plan.density(), scene.render.seed)?,
+            Some(plan) => irradiance::place_samples(&prep, plan.density(), scene.render.seed, &b)?,
             None => Vec::new(),
         };
+        b.finish_and_clear();
         let total: usize = sets.iter().map(|s| s.len()).sum();
         let b = bar(progress, total as u64, "irradiance");
         irradiance::light_samples(&prep, &mut sets, &lighting, &b);
@@ -285,7 +287,9 @@ fn render_in_pool(
         (None, None) => Vec::new(),
         (None, Some(plan)) => {
             let t = Instant::now();
-            let mut sets = irradiance::place_samples(&prep, plan.density(), settings.seed)?;
+            let b = bar(options.progress, 1000, "sampling");
+            let mut sets = irradiance::place_samples(&prep, plan.density(), settings.seed, &b)?;
+            b.finish_and_clear();
             timings.sampling = t.elapsed();
             let t = Instant::now();
             let total: usize = sets.iter().map(|s| s.len()).sum();

@@ -1,151 +1,523 @@
-//! A uniform grid over points for fixed-radius neighbour queries, stored sparsely so that a
-//! thin surface inside a large box costs memory only for the cells it touches.
+//! The candidates of sample elimination in tiles of cells, for fixed-radius neighbour queries
+//! that a task can answer on its own, in cache, while other tasks work on other tiles.
 //!
-//! Points are sorted by cell, so each occupied cell is a contiguous range of the point array;
-//! each occupied cell lists the point ranges of its occupied neighbours (itself included, at
-//! most 27 cells). Neighbouring cells that differ only in z are adjacent in key order, so their
-//! ranges merge: at most 9 ranges per cell. A query around a point scans those ranges, which
-//! hold every point closer than the cell size.
+//! Space is cut into cubic cells of edge `cell` (at least the query radius), and cells into
+//! tiles of [`TILE_CELLS`]³ cells. Candidates are stored tile by tile, and within a tile cell
+//! by cell (each cell a contiguous run of slots); only occupied tiles and cells are stored:
 //!
 //! ```text
-//! record_of:    [0,0,0,0, 4,4,4,4,4, 8,8, ...]  record of each (sorted) point's cell
-//! records:      [(3, 0), (0, 9), (40, 52), (60, 64), (2, 0), ...]
-//!                header (n, 0), then n half-open point ranges, ascending
+//! slots:      [ (p, i) (p, i) ... | (p, i) ... | ... ]   16 B per candidate: position, index
+//!               tile 0              tile 1
+//! tile_start: [ 0, 517, 1032, ... ]                      first slot of each tile (+ end)
+//! tile_cells: [ 0, 83, 170, ... ]                        first cell of each tile (+ end)
+//! cell_key:   [ (x·8 + y)·8 + z, ... ]                   the cell within its tile (u16)
+//! cell_start: [ 0, 6, 11, ... ]                          first slot of each cell
 //! ```
 //!
-//! A point leads straight to its cell's record, header and ranges side by side: one dependent
-//! memory access fewer than separate offset and range arrays, which matters because sample
-//! elimination visits neighbourhoods in random order.
+//! [`Tiles::gather`] copies one tile's candidates and those of the adjacent cells of its 26
+//! neighbour tiles (the halo) into a [`Neighbourhood`]: a dense block of `(8 + 2)³` cells in
+//! local coordinates, so that a query is 9 contiguous runs (cells that differ only in z are
+//! adjacent) without hashing. Each tile lists its 26 neighbours (found once through an
+//! open-addressing table of the tile keys).
+//!
+//! Building it takes two passes over the candidates, which are generated twice instead of
+//! stored twice (see `poisson.rs`): the first counts the candidates of every tile per chunk
+//! of candidates, the second writes each candidate straight to its slot (a counting sort);
+//! then each tile is sorted by cell on its own.
 
-use glam::Vec3;
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-/// Bits per axis of a packed cell key; coordinates are clamped to `0 .. 2²¹`. Clamping is
+/// Cells per tile edge.
+pub(super) const TILE_CELLS: u64 = 7;
+/// Cells per edge of a [`Neighbourhood`]: the tile and one layer of halo on each side.
+pub(super) const LOCAL_CELLS: usize = TILE_CELLS as usize + 2;
+
+/// Bits per axis of a cell coordinate; coordinates are clamped to `0 .. 2²¹`. Clamping is
 /// monotone, so points closer than a cell still land in the same or adjacent cells: an absurdly
 /// elongated surface only makes cells fuller, never misses a neighbour.
 const AXIS_BITS: u32 = 21;
 const AXIS_MAX: u64 = (1 << AXIS_BITS) - 1;
+/// Bits per axis of a tile coordinate.
+const TILE_BITS: u32 = 19;
+const _: () = assert!(TILE_CELLS >= 4 && TILE_CELLS <= 16);
+const TILE_MAX: u64 = (1 << TILE_BITS) - 1;
 
-/// The grid (see the module documentation for the layout).
-pub(super) struct NeighbourGrid {
-    record_of: Vec<u32>,
-    records: Vec<(u32, u32)>,
-}
-
-/// Packs cell coordinates into a key, x-major.
+/// Packs tile coordinates into a key: their bits interleaved (a Morton code), so that tiles
+/// sorted by key are spatially coherent and a phase's tasks, walking them in order, find most
+/// of their neighbours' slots in cache.
 fn pack(c: [u64; 3]) -> u64 {
-    (c[0] << (2 * AXIS_BITS)) | (c[1] << AXIS_BITS) | c[2]
+    spread(c[0]) | spread(c[1]) << 1 | spread(c[2]) << 2
 }
 
-impl NeighbourGrid {
-    /// Builds the grid with cells of edge `cell_size` over `points`, and returns it with the
-    /// permutation that sorts the points by cell (`order[k]` is the input index of the k-th
-    /// sorted point); ties keep input order. The queries of the grid refer to sorted indices.
-    pub(super) fn build(points: &[Vec3], cell_size: f32) -> (NeighbourGrid, Vec<u32>) {
-        let origin = points
+fn unpack(key: u64) -> [u64; 3] {
+    [compact(key), compact(key >> 1), compact(key >> 2)]
+}
+
+/// The low 21 bits of `v` moved to every third bit (bit i to bit 3i).
+fn spread(v: u64) -> u64 {
+    let mut x = v & 0x1f_ffff;
+    x = (x | x << 32) & 0x1f_0000_0000_ffff;
+    x = (x | x << 16) & 0x1f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    (x | x << 2) & 0x1249_2492_4924_9249
+}
+
+/// The inverse of [`spread`]: every third bit gathered into the low 21.
+fn compact(v: u64) -> u64 {
+    let mut x = v & 0x1249_2492_4924_9249;
+    x = (x | x >> 2) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x >> 4) & 0x100f_00f0_0f00_f00f;
+    x = (x | x >> 8) & 0x1f_0000_ff00_00ff;
+    x = (x | x >> 16) & 0x1f_0000_0000_ffff;
+    (x | x >> 32) & 0x1f_ffff
+}
+
+/// One candidate: its position and its index in generation order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Slot {
+    pub(super) position: Vec3,
+    pub(super) index: u32,
+}
+
+/// Where cells lie: the grid's corner and cell edge.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Layout {
+    origin: DVec3,
+    cell: f64,
+}
+
+impl Layout {
+    /// Cells of edge `cell` with a corner at `origin` (at or below every point).
+    pub(super) fn new(origin: Vec3, cell: f32) -> Layout {
+        Layout {
+            origin: origin.as_dvec3(),
+            cell: (cell as f64).max(f64::MIN_POSITIVE),
+        }
+    }
+
+    fn cell_of(&self, p: Vec3) -> [u64; 3] {
+        let q = (p.as_dvec3() - self.origin) / self.cell;
+        [q.x, q.y, q.z].map(|v| v.floor().clamp(0.0, AXIS_MAX as f64) as u64)
+    }
+
+    /// The key of the tile holding `p`.
+    pub(super) fn tile_key(&self, p: Vec3) -> u64 {
+        pack(self.cell_of(p).map(|c| c / TILE_CELLS))
+    }
+
+    /// The cell of `p` within its tile, `(x·8 + y)·8 + z`.
+    fn cell_key(&self, p: Vec3) -> u16 {
+        let c = self.cell_of(p).map(|c| c % TILE_CELLS);
+        ((c[0] * TILE_CELLS + c[1]) * TILE_CELLS + c[2]) as u16
+    }
+
+    /// The minimum corner of tile `key`.
+    fn tile_corner(&self, key: u64) -> DVec3 {
+        let t = unpack(key);
+        let edge = self.cell * TILE_CELLS as f64;
+        self.origin + DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64) * edge
+    }
+}
+
+/// A chunk's tiles: `(tile key, candidates)`, ascending by key.
+pub(super) type ChunkCounts = Vec<(u64, u32)>;
+
+/// Counts the candidates `emit`ted per tile (the first pass), ascending by key.
+pub(super) fn count_tiles(layout: &Layout, each: impl FnOnce(&mut dyn FnMut(Vec3))) -> ChunkCounts {
+    let mut counts: ChunkCounts = Vec::new();
+    each(&mut |p| {
+        let key = layout.tile_key(p);
+        // Consecutive candidates are mostly in the same tile (they come along a curve).
+        match counts.last_mut() {
+            Some((k, n)) if *k == key => *n += 1,
+            _ => counts.push((key, 1)),
+        }
+    });
+    counts.sort_unstable_by_key(|&(k, _)| k);
+    let mut merged: ChunkCounts = Vec::with_capacity(counts.len());
+    for (k, n) in counts {
+        match merged.last_mut() {
+            Some((mk, mn)) if *mk == k => *mn += n,
+            _ => merged.push((k, n)),
+        }
+    }
+    merged
+}
+
+/// The tiles (see the module documentation for the layout).
+pub(super) struct Tiles {
+    layout: Layout,
+    keys: Vec<u64>,
+    /// The 27 tiles around each tile (itself in the middle), `u32::MAX` where there is none.
+    neighbours: Vec<[u32; 27]>,
+    /// First slot of each tile, and the number of slots at the end.
+    tile_start: Vec<u32>,
+    /// First cell of each tile, and the number of cells at the end.
+    tile_cells: Vec<u32>,
+    cell_key: Vec<u16>,
+    cell_start: Vec<u32>,
+    /// The candidates, tile by tile and cell by cell.
+    pub(super) slots: Vec<Slot>,
+}
+
+impl Tiles {
+    /// Builds the tiles from the per-chunk counts of the first pass and a second pass,
+    /// `generate(chunk, emit)`, which must emit the same candidates `(index, position)` in the
+    /// same order as the first pass did for that chunk.
+    pub(super) fn build(
+        layout: Layout,
+        counts: &[ChunkCounts],
+        generate: impl Fn(usize, &mut dyn FnMut(u32, Vec3)) + Sync,
+    ) -> Tiles {
+        let mut keys: Vec<u64> = counts.iter().flatten().map(|&(k, _)| k).collect();
+        keys.par_sort_unstable();
+        keys.dedup();
+        let table = CellTable::new(&keys);
+        // Each chunk's first slot in each of its tiles: tiles in key order, chunks in order
+        // within a tile, candidates in generation order within a chunk.
+        let mut size = vec![0u32; keys.len()];
+        let offsets: Vec<Vec<(u64, u32)>> = counts
             .iter()
-            .fold(Vec3::splat(f32::INFINITY), |m, &p| m.min(p));
-        let inv = 1.0 / (cell_size as f64).max(f64::MIN_POSITIVE);
-        let coord = |x: f32, o: f32| {
-            ((x as f64 - o as f64) * inv)
-                .floor()
-                .clamp(0.0, AXIS_MAX as f64) as u64
-        };
-        let mut keyed: Vec<(u64, u32)> = points
-            .par_iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let c = [
-                    coord(p.x, origin.x),
-                    coord(p.y, origin.y),
-                    coord(p.z, origin.z),
-                ];
-                (pack(c), i as u32)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(|&(k, n)| {
+                        let t = table.get(k).expect("tile counted") as usize;
+                        let at = size[t];
+                        size[t] += n;
+                        (k, at)
+                    })
+                    .collect()
             })
             .collect();
-        // Keys are unique (the index is part of them), so the unstable sort is deterministic.
-        keyed.par_sort_unstable();
-
-        // Occupied cells in key order.
-        let mut cell_keys = Vec::new();
-        let mut cell_start = Vec::new();
-        let mut cell_of = Vec::with_capacity(points.len());
-        for (k, &(key, _)) in keyed.iter().enumerate() {
-            if cell_keys.last() != Some(&key) {
-                cell_keys.push(key);
-                cell_start.push(k as u32);
-            }
-            cell_of.push(cell_keys.len() as u32 - 1);
+        let mut tile_start = Vec::with_capacity(keys.len() + 1);
+        let mut total = 0u32;
+        for &n in &size {
+            tile_start.push(total);
+            total += n;
         }
-        cell_start.push(points.len() as u32);
-        let order: Vec<u32> = keyed.into_iter().map(|(_, i)| i).collect();
+        tile_start.push(total);
+        drop(size);
 
-        let table = CellTable::new(&cell_keys);
-        let per_cell: Vec<Ranges> = cell_keys
+        // Second pass: every slot is written exactly once, by the chunk that owns it, so
+        // relaxed atomic stores (plain moves on x86) make the scatter safe and deterministic.
+        let scatter: Vec<[AtomicU32; 4]> = (0..total)
+            .map(|_| [const { AtomicU32::new(0) }; 4])
+            .collect();
+        offsets.par_iter().enumerate().for_each(|(c, chunk)| {
+            let mut cursor: Vec<u32> = chunk
+                .iter()
+                .map(|&(k, at)| tile_start[table.get(k).expect("tile") as usize] + at)
+                .collect();
+            let mut last = 0usize;
+            generate(c, &mut |index, p| {
+                let key = layout.tile_key(p);
+                if chunk[last].0 != key {
+                    last = chunk.partition_point(|&(k, _)| k < key);
+                }
+                let s = &scatter[cursor[last] as usize];
+                cursor[last] += 1;
+                for (a, v) in s
+                    .iter()
+                    .zip([p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), index])
+                {
+                    a.store(v, Ordering::Relaxed);
+                }
+            });
+        });
+        drop(offsets);
+        // Reuses the allocation (same size and alignment).
+        let mut slots: Vec<Slot> = scatter
+            .into_iter()
+            .map(|s| {
+                let [x, y, z, index] = s.map(AtomicU32::into_inner);
+                Slot {
+                    position: Vec3::new(f32::from_bits(x), f32::from_bits(y), f32::from_bits(z)),
+                    index,
+                }
+            })
+            .collect();
+
+        // Sort each tile by cell (ties: generation order, so unique keys), and list its cells.
+        let mut parts = Vec::with_capacity(keys.len());
+        let mut rest = &mut slots[..];
+        for t in 0..keys.len() {
+            let (part, tail) = rest.split_at_mut((tile_start[t + 1] - tile_start[t]) as usize);
+            parts.push((tile_start[t], part));
+            rest = tail;
+        }
+        let cells: Vec<Vec<(u16, u32)>> = parts
+            .into_par_iter()
+            .map(|(first, part)| {
+                let mut keyed: Vec<(u16, u32, Slot)> = part
+                    .iter()
+                    .map(|s| (layout.cell_key(s.position), s.index, *s))
+                    .collect();
+                keyed.sort_unstable_by_key(|&(key, index, _)| (key, index));
+                let mut cells: Vec<(u16, u32)> = Vec::new();
+                for (k, (&(key, _, s), out)) in keyed.iter().zip(part.iter_mut()).enumerate() {
+                    *out = s;
+                    if cells.last().is_none_or(|&(c, _)| c != key) {
+                        cells.push((key, first + k as u32));
+                    }
+                }
+                cells
+            })
+            .collect();
+        let mut tile_cells = Vec::with_capacity(keys.len() + 1);
+        let count: usize = cells.iter().map(Vec::len).sum();
+        let (mut cell_key, mut cell_start) = (Vec::with_capacity(count), Vec::with_capacity(count));
+        for c in &cells {
+            tile_cells.push(cell_key.len() as u32);
+            cell_key.extend(c.iter().map(|&(k, _)| k));
+            cell_start.extend(c.iter().map(|&(_, s)| s));
+        }
+        tile_cells.push(cell_key.len() as u32);
+        let neighbours = keys
             .par_iter()
             .map(|&key| {
-                let c = [
-                    key >> (2 * AXIS_BITS),
-                    (key >> AXIS_BITS) & AXIS_MAX,
-                    key & AXIS_MAX,
-                ];
-                let mut list = Ranges::default();
-                // This loop order visits keys in ascending order, so cells come ascending and
-                // runs of consecutive cells merge into one range.
+                let tile = unpack(key);
+                let mut near = [u32::MAX; 27];
+                let mut k = 0;
                 for dx in -1i64..=1 {
                     for dy in -1i64..=1 {
                         for dz in -1i64..=1 {
-                            let n = [c[0] as i64 + dx, c[1] as i64 + dy, c[2] as i64 + dz];
-                            if n.iter().any(|&v| v < 0 || v > AXIS_MAX as i64) {
-                                continue;
+                            let n = [
+                                tile[0] as i64 + dx,
+                                tile[1] as i64 + dy,
+                                tile[2] as i64 + dz,
+                            ];
+                            if n.iter().all(|&v| (0..=TILE_MAX as i64).contains(&v)) {
+                                near[k] = table.get(pack(n.map(|v| v as u64))).unwrap_or(u32::MAX);
                             }
-                            let Some(cell) = table.get(pack(n.map(|v| v as u64))) else {
-                                continue;
-                            };
-                            let (a, b) = (cell_start[cell as usize], cell_start[cell as usize + 1]);
-                            list.push(a, b);
+                            k += 1;
                         }
                     }
                 }
-                list
+                near
             })
             .collect();
-        let mut records = Vec::with_capacity(per_cell.iter().map(|l| l.len + 1).sum());
-        let mut record_start = Vec::with_capacity(per_cell.len());
-        for l in &per_cell {
-            record_start.push(records.len() as u32);
-            records.push((l.len as u32, 0));
-            records.extend_from_slice(&l.ranges[..l.len]);
+        Tiles {
+            layout,
+            keys,
+            neighbours,
+            tile_start,
+            tile_cells,
+            cell_key,
+            cell_start,
+            slots,
         }
-        let record_of = cell_of.iter().map(|&c| record_start[c as usize]).collect();
-        (NeighbourGrid { record_of, records }, order)
     }
 
-    /// The point ranges around point `i` (including `i` itself), ascending and disjoint.
-    /// Every point closer to `i` than the cell size is in them.
+    /// Number of tiles.
+    pub(super) fn len(&self) -> usize {
+        self.keys.len()
+    }
+
+    /// The slots of tile `t`.
+    pub(super) fn slot_range(&self, t: usize) -> std::ops::Range<usize> {
+        self.tile_start[t] as usize..self.tile_start[t + 1] as usize
+    }
+
+    /// The colour of tile `t`, 0–7: the parities of its coordinates. Tiles of one colour are
+    /// at least a tile apart, so their neighbourhoods (a tile and one cell around it) do not
+    /// reach each other's candidates.
+    pub(super) fn colour(&self, t: usize) -> usize {
+        let c = unpack(self.keys[t]);
+        ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) as usize
+    }
+
+    /// Copies tile `t`'s candidates and its halo into `out`, leaving out the slots `skip`
+    /// names, with positions relative to the tile's corner in units of `unit`.
+    pub(super) fn gather(
+        &self,
+        t: usize,
+        unit: f32,
+        skip: impl Fn(u32) -> bool,
+        out: &mut Neighbourhood,
+    ) {
+        let k = TILE_CELLS as i64;
+        let local = |key: u16, shift: [i64; 3]| -> Option<usize> {
+            let c = [key as i64 / (k * k), key as i64 / k % k, key as i64 % k];
+            let mut l = [0usize; 3];
+            for a in 0..3 {
+                let v = c[a] + shift[a] * k + 1;
+                if !(0..LOCAL_CELLS as i64).contains(&v) {
+                    return None;
+                }
+                l[a] = v as usize;
+            }
+            Some((l[0] * LOCAL_CELLS + l[1]) * LOCAL_CELLS + l[2])
+        };
+        out.runs.clear();
+        let mut near = self.neighbours[t].iter();
+        for dx in -1i64..=1 {
+            for dy in -1i64..=1 {
+                for dz in -1i64..=1 {
+                    let own = (dx, dy, dz) == (0, 0, 0);
+                    let u = *near.next().expect("27 neighbours");
+                    if u == u32::MAX {
+                        continue;
+                    }
+                    // Only the cells of `u` next to this tile: along an axis where `u` is
+                    // offset, its first or last layer. Keys are x-major, so a fixed (x, y) is
+                    // one run of keys, found by binary search.
+                    let layer = |d: i64| match d {
+                        1 => 0..1,
+                        -1 => k - 1..k,
+                        _ => 0..k,
+                    };
+                    let (first, last) = (
+                        self.tile_cells[u as usize] as usize,
+                        self.tile_cells[u as usize + 1] as usize,
+                    );
+                    let keys = &self.cell_key[first..last];
+                    let mut add = |c: usize| {
+                        let key = keys[c] as i64;
+                        if let Some(l) = local(key as u16, [dx, dy, dz]) {
+                            let a = self.cell_start[first + c];
+                            let b = if first + c + 1 < last {
+                                self.cell_start[first + c + 1]
+                            } else {
+                                self.tile_start[u as usize + 1]
+                            };
+                            out.runs.push((l as u32, a, b, own));
+                        }
+                    };
+                    if dx == 0 && dy == 0 {
+                        (0..keys.len()).for_each(&mut add);
+                    } else {
+                        for x in layer(dx) {
+                            for y in layer(dy) {
+                                let lo = ((x * k + y) * k) as u16;
+                                let a = keys.partition_point(|&c| c < lo);
+                                let b = a + keys[a..].partition_point(|&c| c < lo + k as u16);
+                                (a..b).for_each(&mut add);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out.runs.sort_unstable_by_key(|r| r.0);
+
+        let corner = self.layout.tile_corner(self.keys[t]);
+        let inv = 1.0 / unit as f64;
+        out.clear();
+        let mut next = 0usize;
+        for &(l, a, b, own) in &out.runs {
+            while next <= l as usize {
+                out.start[next] = out.x.len() as u32;
+                next += 1;
+            }
+            for s in a..b {
+                if skip(s) {
+                    continue;
+                }
+                let q = (self.slots[s as usize].position.as_dvec3() - corner) * inv;
+                out.x.push(q.x as f32);
+                out.y.push(q.y as f32);
+                out.z.push(q.z as f32);
+                out.cell.push(l as u16);
+                out.slot.push(s);
+                out.own.push(own);
+            }
+        }
+        let len = out.x.len() as u32;
+        for s in &mut out.start[next..] {
+            *s = len;
+        }
+    }
+}
+
+/// One tile and its halo in local coordinates (see [`Tiles::gather`]), reused across tiles.
+///
+/// ```text
+/// x, y, z:  [ 0.2  0.9  0.4  8.1 … ]     positions (tile corner = 0), in local cell order
+/// cell:     [ 0    0    111  111 … ]     their local cells, (x·10 + y)·10 + z
+/// slot:     [ 9    14   1032 1033 … ]    their slots in `Tiles::slots`
+/// own:      [ no   no   yes  yes … ]     the tile's own (else halo)
+/// start:    [ 0, 0, 2, 2, 2, ... ]       first point of each of the 10³ local cells (+ end)
+/// ```
+#[derive(Clone)]
+pub(super) struct Neighbourhood {
+    pub(super) x: Vec<f32>,
+    pub(super) y: Vec<f32>,
+    pub(super) z: Vec<f32>,
+    pub(super) cell: Vec<u16>,
+    pub(super) slot: Vec<u32>,
+    pub(super) own: Vec<bool>,
+    start: Vec<u32>,
+    runs: Vec<(u32, u32, u32, bool)>,
+}
+
+impl Default for Neighbourhood {
+    fn default() -> Neighbourhood {
+        Neighbourhood {
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            cell: Vec::new(),
+            slot: Vec::new(),
+            own: Vec::new(),
+            start: vec![0; LOCAL_CELLS * LOCAL_CELLS * LOCAL_CELLS + 1],
+            runs: Vec::new(),
+        }
+    }
+}
+
+impl Neighbourhood {
+    fn clear(&mut self) {
+        self.x.clear();
+        self.y.clear();
+        self.z.clear();
+        self.cell.clear();
+        self.slot.clear();
+        self.own.clear();
+    }
+
+    /// Number of points.
+    pub(super) fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// The point runs around local cell `cell` (an own point's): 9 contiguous, ascending,
+    /// disjoint runs covering the 27 cells around it, which hold every point closer than a
+    /// cell.
     #[inline]
-    pub(super) fn ranges_near(&self, i: u32) -> &[(u32, u32)] {
-        let r = self.record_of[i as usize] as usize;
-        &self.records[r + 1..r + 1 + self.records[r].0 as usize]
+    pub(super) fn runs_near(&self, cell: u16, out: &mut [(u32, u32); 9]) {
+        const L: usize = LOCAL_CELLS;
+        let c = cell as usize;
+        let mut k = 0;
+        for dx in [c - L * L, c, c + L * L] {
+            for d in [dx - L, dx, dx + L] {
+                out[k] = (self.start[d - 1], self.start[d + 2]);
+                k += 1;
+            }
+        }
     }
 }
 
-/// The merged point ranges around one cell (at most 9: one per (dx, dy) column).
-#[derive(Clone, Copy, Default)]
-struct Ranges {
-    ranges: [(u32, u32); 9],
-    len: usize,
-}
+/// A bitmap shared by the tasks of a phase: each task sets only bits of its own tile's slots
+/// and reads others' (of tiles no task of the phase writes), so the outcome does not depend on
+/// timing.
+pub(super) struct Bits(Vec<AtomicU64>);
 
-impl Ranges {
-    /// Appends `a..b`, merging it into the last range when they touch.
-    fn push(&mut self, a: u32, b: u32) {
-        if self.len > 0 && self.ranges[self.len - 1].1 == a {
-            self.ranges[self.len - 1].1 = b;
-        } else {
-            self.ranges[self.len] = (a, b);
-            self.len += 1;
-        }
+impl Bits {
+    pub(super) fn new(len: usize) -> Bits {
+        Bits((0..len.div_ceil(64)).map(|_| AtomicU64::new(0)).collect())
+    }
+    #[inline]
+    pub(super) fn get(&self, i: u32) -> bool {
+        self.0[i as usize / 64].load(Ordering::Relaxed) >> (i % 64) & 1 != 0
+    }
+    #[inline]
+    pub(super) fn set(&self, i: u32) {
+        self.0[i as usize / 64].fetch_or(1u64 << (i % 64), Ordering::Relaxed);
     }
 }
 
@@ -204,10 +576,29 @@ mod tests {
     use crate::sampling::rng::Pcg32;
 
     #[test]
-    fn finds_exactly_the_brute_force_neighbours() {
+    fn tile_keys_interleave_the_bits() {
+        let mut rng = Pcg32::new(2, 2);
+        for _ in 0..1000 {
+            let c = [0; 3].map(|_: u64| rng.next_below(1 << TILE_BITS) as u64);
+            let mut want = 0u64;
+            for bit in 0..TILE_BITS {
+                for (a, &v) in c.iter().enumerate() {
+                    want |= (v >> bit & 1) << (3 * bit + a as u32);
+                }
+            }
+            assert_eq!(pack(c), want);
+            assert_eq!(unpack(want), c);
+        }
+    }
+
+    /// Every tile's neighbourhood, queried around each of its own points, holds exactly the
+    /// points (not skipped) closer than a cell, by brute force; every point is in exactly one
+    /// tile; the slots of each cell are in generation order.
+    #[test]
+    fn neighbourhoods_hold_exactly_the_brute_force_neighbours() {
         let mut rng = Pcg32::new(11, 0);
-        // Points on two parallel planes and a sparse cloud: many empty cells.
-        let mut pts: Vec<Vec3> = (0..3000)
+        // Points on two parallel planes and a sparse cloud: many empty cells and tiles.
+        let mut pts: Vec<Vec3> = (0..6000)
             .map(|k| {
                 let (a, b) = (rng.next_f32() * 4.0, rng.next_f32() * 4.0);
                 match k % 3 {
@@ -219,28 +610,69 @@ mod tests {
             .collect();
         pts.push(pts[5]); // an exact duplicate
         let r = 0.21;
-        let (grid, order) = NeighbourGrid::build(&pts, r);
-        let sorted: Vec<Vec3> = order.iter().map(|&i| pts[i as usize]).collect();
-        let mut seen = vec![false; pts.len()];
-        for &i in &order {
-            assert!(!seen[i as usize]);
-            seen[i as usize] = true;
-        }
-        for i in 0..sorted.len() as u32 {
-            let mut got = Vec::new();
-            let ranges = grid.ranges_near(i);
-            assert!(ranges.windows(2).all(|w| w[0].1 < w[1].0), "{ranges:?}");
-            for &(a, b) in ranges {
-                for j in a..b {
-                    if j != i && sorted[i as usize].distance(sorted[j as usize]) < r {
-                        got.push(j);
-                    }
-                }
+        let layout = Layout::new(Vec3::ZERO, r);
+        // Three chunks of unequal size.
+        let bounds = [0, 1000, 1001, pts.len()];
+        let chunk = |c: usize, emit: &mut dyn FnMut(u32, Vec3)| {
+            for i in bounds[c]..bounds[c + 1] {
+                emit(i as u32, pts[i]);
             }
-            let want: Vec<u32> = (0..sorted.len() as u32)
-                .filter(|&j| j != i && sorted[i as usize].distance(sorted[j as usize]) < r)
-                .collect();
-            assert_eq!(got, want, "point {i}");
+        };
+        let counts: Vec<ChunkCounts> = (0..3)
+            .map(|c| count_tiles(&layout, |emit| chunk(c, &mut |_, p| emit(p))))
+            .collect();
+        let tiles = Tiles::build(layout, &counts, chunk);
+        assert!(tiles.len() > 8);
+        let mut seen = vec![false; pts.len()];
+        for s in &tiles.slots {
+            assert!(!seen[s.index as usize]);
+            seen[s.index as usize] = true;
+            assert_eq!(s.position, pts[s.index as usize]);
         }
+        let skipped = |s: u32| s % 7 == 3;
+        let mut near = Neighbourhood::default();
+        let mut runs = [(0, 0); 9];
+        let mut owned = 0;
+        for t in 0..tiles.len() {
+            let range = tiles.slot_range(t);
+            assert!(tiles.slots[range.clone()].windows(2).all(|w| (
+                layout.cell_key(w[0].position),
+                w[0].index
+            ) < (
+                layout.cell_key(w[1].position),
+                w[1].index
+            )));
+            tiles.gather(t, 0.5, skipped, &mut near);
+            for i in 0..near.len() {
+                assert!(!skipped(near.slot[i]));
+                if !near.own[i] {
+                    assert!(!range.contains(&(near.slot[i] as usize)));
+                    continue;
+                }
+                assert!(range.contains(&(near.slot[i] as usize)));
+                owned += 1;
+                near.runs_near(near.cell[i], &mut runs);
+                assert!(runs.windows(2).all(|w| w[0].1 <= w[1].0), "{runs:?}");
+                let me = tiles.slots[near.slot[i] as usize].position;
+                let mut got: Vec<u32> = runs
+                    .iter()
+                    .flat_map(|&(a, b)| a..b)
+                    .map(|j| near.slot[j as usize])
+                    .filter(|&s| me.distance(tiles.slots[s as usize].position) < r)
+                    .collect();
+                got.sort_unstable();
+                let want: Vec<u32> = (0..tiles.slots.len() as u32)
+                    .filter(|&s| !skipped(s) && me.distance(tiles.slots[s as usize].position) < r)
+                    .collect();
+                assert_eq!(got, want, "tile {t}, slot {}", near.slot[i]);
+                // Local coordinates: the tile corner is 0, the unit 0.5.
+                let q = near.x[i] * 0.5;
+                assert!((q - (me.x - layout.tile_corner(tiles.keys[t]).x as f32)).abs() < 1e-5);
+            }
+        }
+        assert_eq!(
+            owned,
+            (0..pts.len() as u32).filter(|&s| !skipped(s)).count()
+        );
     }
 }

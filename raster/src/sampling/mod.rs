@@ -22,7 +22,7 @@
 //! |---|---|
 //! | `rng.rs` | PCG32 and SplitMix64 (deterministic randomness) |
 //! | `surface.rs` | surface points, sample counts, area-uniform candidates |
-//! | `grid.rs` | sparse uniform grid for neighbour queries |
+//! | `grid.rs` | tiles of cells over the candidates: neighbourhoods for parallel elimination |
 //! | `maxtree.rs` | blocked tournament tree: the heaviest candidate |
 //! | `poisson.rs` | weighted sample elimination |
 //! | `voronoi/` | per-sample areas: restricted Voronoi cells (grid, clipping, completion) |
@@ -40,7 +40,7 @@ mod surface;
 mod voronoi;
 
 pub use error::{MAX_SAMPLES, SamplingError};
-pub use poisson::poisson_samples;
+pub use poisson::{poisson_samples, poisson_samples_with_progress};
 pub use stratified::{StratifiedSquare, stratified_square};
 pub use surface::{SampleTarget, SurfacePoint, hex_spacing, total_area, triangle_area};
 pub use voronoi::{VoronoiAreas, VoronoiStats, voronoi_areas};

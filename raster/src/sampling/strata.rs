@@ -10,8 +10,10 @@
 //! So candidates are stratified along a space-filling curve:
 //!
 //! 1. triangles larger than [`PIECE_CANDIDATES`] candidates' worth of area are split by midpoint
-//!    subdivision into equal-area pieces;
-//! 2. pieces are ordered by the Morton code of their centroid (spatially coherent);
+//!    subdivision into 4^L equal-area pieces, numbered in the subdivision's own recursive order
+//!    (each run of 4^l consecutive pieces is one sub-triangle, so compact);
+//! 2. triangles are ordered by the Morton code of their centroid (spatially coherent), each
+//!    bringing its pieces in a row;
 //! 3. candidate i takes the piece at cumulative area (i + ξᵢ) · A / M along that order, ξᵢ
 //!    uniform in [0, 1), and a uniform point within it.
 //!
@@ -19,6 +21,12 @@
 //! any compact region of the surface is a few such runs, so its count is nearly exact. The
 //! randomness within strata (ξᵢ and the point in the piece) keeps the set free of lattice
 //! patterns.
+//!
+//! Pieces are implicit: only the triangles are stored (index, subdivision depth, cumulative
+//! area: 13 bytes each), and a piece's corners are decoded from its number (two bits per
+//! level). Storing the pieces themselves cost ~80 bytes per sample at the default ratio of
+//! five candidates. The cumulative areas are strictly increasing along `i`, so a run of
+//! consecutive candidates walks the triangles forward instead of searching them.
 
 use glam::{DVec3, Vec2, Vec3};
 use lucent_core::morton::Grid;
@@ -31,17 +39,16 @@ const PIECE_CANDIDATES: f64 = 4.0;
 /// Deepest subdivision (4¹² ≈ 17M pieces from one triangle).
 const MAX_LEVELS: u32 = 12;
 
-/// A piece of a triangle: its corners in the parent's barycentric coordinates (b1, b2).
-#[derive(Clone, Copy, Debug)]
-struct Piece {
-    triangle: u32,
-    corners: [Vec2; 3],
-}
-
-/// Pieces in Morton order with their cumulative areas.
+/// The triangles in Morton order with their subdivision depths and cumulative areas.
+///
+/// ```text
+/// triangle:   [ 17,  3,  4, 250, ... ]   input index, Morton order of the centroids
+/// levels:     [  2,  0,  0,   5, ... ]   the triangle is cut into 4^levels pieces
+/// cumulative: [ a17, a17+a3, ...     ]   area of this and every earlier triangle (f64)
+/// ```
 pub(super) struct Strata {
-    pieces: Vec<Piece>,
-    /// `cumulative[i]` = area of pieces `0..=i`.
+    triangle: Vec<u32>,
+    levels: Vec<u8>,
     cumulative: Vec<f64>,
 }
 
@@ -55,110 +62,115 @@ fn point_at(t: &[Vec3; 3], b: Vec2) -> Vec3 {
     p.as_vec3()
 }
 
+/// The child `digit` (0–3) of a triangle under midpoint subdivision: three corner triangles and
+/// the middle one, each a quarter of the area.
+fn child(corners: [Vec2; 3], digit: u32) -> [Vec2; 3] {
+    let [a, b, c] = corners;
+    let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
+    match digit {
+        0 => [a, ab, ca],
+        1 => [ab, b, bc],
+        2 => [ca, bc, c],
+        _ => [bc, ca, ab],
+    }
+}
+
+/// The corners (barycentric) of piece `index` of a triangle cut `levels` times: base-4 digits,
+/// most significant first, each choosing a child.
+fn piece_corners(levels: u32, index: u64) -> [Vec2; 3] {
+    let mut corners = [Vec2::ZERO, Vec2::X, Vec2::Y];
+    for l in (0..levels).rev() {
+        corners = child(corners, ((index >> (2 * l)) & 3) as u32);
+    }
+    corners
+}
+
 impl Strata {
-    /// Pieces for `m` candidates over `triangles` (finite, validated by the caller) of total
+    /// Strata for `m` candidates over `triangles` (finite, validated by the caller) of total
     /// area `total`.
     pub(super) fn new(triangles: &[[Vec3; 3]], total: f64, m: usize) -> Strata {
         let max_area = PIECE_CANDIDATES * total / m.max(1) as f64;
-        let mut pieces = Vec::new();
-        let mut areas = Vec::new();
-        let root = [Vec2::ZERO, Vec2::X, Vec2::Y];
-        for (i, t) in triangles.iter().enumerate() {
-            let a = triangle_area(t);
-            if !(a > 0.0) {
-                continue;
-            }
-            let mut levels = 0;
-            while levels < MAX_LEVELS && a / 4f64.powi(levels as i32) > max_area {
-                levels += 1;
-            }
-            let piece_area = a / 4f64.powi(levels as i32);
-            subdivide(root, levels, &mut |corners| {
-                pieces.push(Piece {
-                    triangle: i as u32,
-                    corners,
-                });
-                areas.push(piece_area);
-            });
-        }
-        // Morton order of the centroids; ties (identical codes) keep the generation order.
-        let centroids: Vec<Vec3> = pieces
+        // Morton order of the centroids; ties (identical codes) keep the input order.
+        let (lo, hi) = triangles
             .iter()
-            .map(|p| {
-                point_at(
-                    &triangles[p.triangle as usize],
-                    (p.corners[0] + p.corners[1] + p.corners[2]) / 3.0,
-                )
-            })
-            .collect();
-        let (lo, hi) = centroids
-            .iter()
+            .flatten()
             .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &c| {
                 (lo.min(c), hi.max(c))
             });
         let grid = Grid::new(lo, hi);
-        let mut order: Vec<(u64, u32)> = centroids
+        let mut order: Vec<(u64, u32)> = triangles
             .iter()
             .enumerate()
-            .map(|(i, &c)| (grid.code(c), i as u32))
+            .filter(|(_, t)| triangle_area(t) > 0.0)
+            .map(|(i, t)| (grid.code((t[0] + t[1] + t[2]) / 3.0), i as u32))
             .collect();
         order.sort_unstable();
+        let mut strata = Strata {
+            triangle: Vec::with_capacity(order.len()),
+            levels: Vec::with_capacity(order.len()),
+            cumulative: Vec::with_capacity(order.len()),
+        };
         let mut sum = 0.0;
-        let cumulative = order
-            .iter()
-            .map(|&(_, i)| {
-                sum += areas[i as usize];
-                sum
-            })
-            .collect();
-        let pieces = order.iter().map(|&(_, i)| pieces[i as usize]).collect();
-        Strata { pieces, cumulative }
+        for &(_, i) in &order {
+            let a = triangle_area(&triangles[i as usize]);
+            let mut levels = 0;
+            while levels < MAX_LEVELS && a / 4f64.powi(levels as i32) > max_area {
+                levels += 1;
+            }
+            sum += a;
+            strata.triangle.push(i);
+            strata.levels.push(levels as u8);
+            strata.cumulative.push(sum);
+        }
+        strata
     }
 
-    /// Candidate `i` of `m`: the piece at cumulative area (i + ξ)·A/m, then a uniform point in
-    /// it (square-root warp, Osada et al. 2002).
-    pub(super) fn candidate(
+    /// Candidates `first .. first + out.len()` of `m`, in order, drawing from `rng`: candidate
+    /// `i` takes the piece at cumulative area (i + ξ)·A/m, then a uniform point in it
+    /// (square-root warp, Osada et al. 2002). Each candidate draws four numbers.
+    pub(super) fn candidates(
         &self,
         triangles: &[[Vec3; 3]],
-        i: usize,
+        first: usize,
+        count: usize,
         m: usize,
         rng: &mut Pcg32,
-    ) -> SurfacePoint {
+        mut emit: impl FnMut(usize, SurfacePoint),
+    ) {
         let total = self.cumulative.last().copied().unwrap_or(0.0);
-        let u = (i as f64 + rng.next_f64()) / m as f64 * total;
-        let k = self
-            .cumulative
-            .partition_point(|&c| c <= u)
-            .min(self.pieces.len() - 1);
-        let piece = &self.pieces[k];
-        let su = rng.next_f32().sqrt();
-        let t = su * rng.next_f32();
-        let s = su - t;
-        let bary = lerp_bary(&piece.corners, s, t);
-        SurfacePoint {
-            position: point_at(&triangles[piece.triangle as usize], bary),
-            triangle: piece.triangle,
-            bary,
+        let last = self.cumulative.len() - 1;
+        let mut k = 0;
+        for i in first..first + count {
+            let u = (i as f64 + rng.next_f64()) / m as f64 * total;
+            // u grows with i, so the triangle index only moves forward; the first candidate
+            // of a run searches.
+            if i == first {
+                k = self.cumulative.partition_point(|&c| c <= u).min(last);
+            } else {
+                while k < last && self.cumulative[k] <= u {
+                    k += 1;
+                }
+            }
+            let before = if k == 0 { 0.0 } else { self.cumulative[k - 1] };
+            let levels = self.levels[k] as u32;
+            let pieces = 1u64 << (2 * levels);
+            let piece_area = (self.cumulative[k] - before) / pieces as f64;
+            let piece = (((u - before) / piece_area).max(0.0) as u64).min(pieces - 1);
+            let corners = piece_corners(levels, piece);
+            let su = rng.next_f32().sqrt();
+            let t = su * rng.next_f32();
+            let s = su - t;
+            let bary = lerp_bary(&corners, s, t);
+            let triangle = self.triangle[k];
+            emit(
+                i,
+                SurfacePoint {
+                    position: point_at(&triangles[triangle as usize], bary),
+                    triangle,
+                    bary,
+                },
+            );
         }
-    }
-
-    /// Number of pieces.
-    #[cfg(test)]
-    pub(super) fn len(&self) -> usize {
-        self.pieces.len()
-    }
-}
-
-/// Calls `emit` with the 4^levels equal-area pieces of `corners` (midpoint subdivision).
-fn subdivide(corners: [Vec2; 3], levels: u32, emit: &mut impl FnMut([Vec2; 3])) {
-    if levels == 0 {
-        emit(corners);
-        return;
-    }
-    let [a, b, c] = corners;
-    let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
-    for child in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]] {
-        subdivide(child, levels - 1, emit);
     }
 }
 
@@ -175,17 +187,45 @@ mod tests {
         ];
         // 8 units² for 200 candidates: pieces of at most 0.16 → 4³ = 64 pieces of 0.125.
         let s = Strata::new(&[tri], 8.0, 200);
-        assert_eq!(s.len(), 64);
+        assert_eq!(s.levels, [3]);
         assert!((s.cumulative.last().unwrap() - 8.0).abs() < 1e-9);
-        // Every piece lies inside the parent and has 1/256 of its area.
-        for p in &s.pieces {
-            for c in p.corners {
+        // Every piece lies inside the parent and has 1/64 of its area; together they cover it
+        // without overlap: every point of a fine lattice lies in exactly one piece.
+        let pieces: Vec<[Vec2; 3]> = (0..64).map(|i| piece_corners(3, i)).collect();
+        for p in &pieces {
+            for c in p {
                 assert!(c.x >= 0.0 && c.y >= 0.0 && c.x + c.y <= 1.0 + 1e-6);
             }
-            let e1 = p.corners[1] - p.corners[0];
-            let e2 = p.corners[2] - p.corners[0];
+            let e1 = p[1] - p[0];
+            let e2 = p[2] - p[0];
             let area = 0.5 * (e1.x * e2.y - e1.y * e2.x).abs();
             assert!((area - 0.5 / 64.0).abs() < 1e-7);
+        }
+        let inside = |p: &[Vec2; 3], q: Vec2| {
+            let side = |a: Vec2, b: Vec2| (b - a).perp_dot(q - a);
+            let (s0, s1, s2) = (side(p[0], p[1]), side(p[1], p[2]), side(p[2], p[0]));
+            (s0 > 0.0 && s1 > 0.0 && s2 > 0.0) || (s0 < 0.0 && s1 < 0.0 && s2 < 0.0)
+        };
+        for a in 0..97 {
+            for b in 0..97 - a {
+                // Off the pieces' edges (multiples of 1/8) by an irrational-ish offset.
+                let q = Vec2::new(a as f32 + 0.31, b as f32 + 0.17) / 97.7;
+                if q.x + q.y >= 1.0 {
+                    continue;
+                }
+                let hits = pieces.iter().filter(|p| inside(p, q)).count();
+                assert_eq!(hits, 1, "{q}");
+            }
+        }
+        // Consecutive pieces are compact: each run of four is one sub-triangle.
+        for (run, four) in pieces.chunks(4).enumerate() {
+            let parent = piece_corners(2, run as u64);
+            for p in four {
+                for c in p {
+                    let centroid = (parent[0] + parent[1] + parent[2]) / 3.0;
+                    assert!(c.distance(centroid) < 0.25, "run {run}");
+                }
+            }
         }
     }
 
@@ -203,14 +243,13 @@ mod tests {
         let s = Strata::new(&tris, 1600.0, m);
         let mut rng = Pcg32::new(1, 1);
         let mut counts = vec![0u32; 100];
-        for i in 0..m {
-            let c = s.candidate(&tris, i, m, &mut rng);
+        s.candidates(&tris, 0, m, m, &mut rng, |_, c| {
             let (bx, by) = (
                 ((c.position.x + 20.0) / 4.0) as usize,
                 ((c.position.y + 20.0) / 4.0) as usize,
             );
             counts[by.min(9) * 10 + bx.min(9)] += 1;
-        }
+        });
         let mean = m as f64 / 100.0;
         let worst = counts
             .iter()
