@@ -98,8 +98,13 @@ pub(crate) struct Params {
     pub kernel: Kernel,
     /// E(x): decides whether N10's deferred unlit subtrees matter.
     pub irradiance: Vec3,
-    /// N10: per channel 1/(Rd(0)·Ā) (clamped into the f32 range), the scale of its weights.
-    pub local_scale: [f32; 3],
+    /// N10: per channel a power of two at most 1/Rd(0), so that Rd·`rd_scale` ≤ 1.
+    pub rd_scale: [f32; 3],
+    /// N10: a power of two at most 1/Ā, so that A·`area_scale` ≤ A/Ā.
+    pub area_scale: f32,
+    /// N10: per channel a power of two at most 1/Φ (Φ the cache's total flux), so that the
+    /// scaled local flux sum stays ≤ 1.
+    pub flux_scale: [f32; 3],
 }
 
 /// What a traversal returns, per channel.
@@ -107,9 +112,9 @@ pub(crate) struct Params {
 pub(crate) struct Sums {
     /// Σ Rd·E·A (hierarchical) or Σ (1 − w)·Rd·E·A (split modes).
     pub global: Vec3,
-    /// N10: Σ w·Rd·E·A, scaled by `Params::local_scale`.
+    /// N10: Σ w·Rd·E·A, scaled by `Params::rd_scale` and `Params::flux_scale`.
     pub local_flux: Vec3,
-    /// N10: Σ w·Rd·A, scaled by `Params::local_scale`.
+    /// N10: Σ w·Rd·A, scaled by `Params::rd_scale` and `Params::area_scale`.
     pub local_weight: Vec3,
 }
 
@@ -199,7 +204,9 @@ struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     cache: &'a IrradianceCache,
     profile: &'a Profile,
     kernel: Kernel,
-    local_scale: [f32; 3],
+    rd_scale: [f32; 3],
+    area_scale: f32,
+    flux_scale: [f32; 3],
     x: [L; 3],
     /// Sample terms: r², flux r g b, area.
     samples: Buffer<5>,
@@ -281,18 +288,23 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         }
         let w = self.kernel.weight_lanes(r2);
         let one_minus_w = L::splat(1.0) - w;
-        let area = area.keep(valid);
+        // N10's sums are scaled so that they stay O(1) whatever the units: the weight
+        // w·Rd·A as w·(Rd/Rd(0))·(A/Ā), its flux w·Rd·E·A as w·(Rd/Rd(0))·(E·A/Φ). Unscaled,
+        // Rd·A underflowed to subnormals at tiny scales and the local irradiance lost every
+        // digit. Each factor is scaled on its own, by a power of two (exact, see
+        // `Params`): one combined factor 1/(Rd(0)·Ā) overflowed Rd·scale to +∞ where
+        // Ā < 2⁻¹²⁷ (∞/∞ = NaN, and E_loc fell back to E(x)), and w·(Rd/Rd(0))·E·A/Ā summed
+        // past f32 where irradiances near 10³⁶ meet a few hundred samples within α.
+        let area = area.keep(valid) * L::splat(self.area_scale);
         for c in 0..3 {
             // The kernel factor multiplies the flux first: where it is 0, a term is 0 even if
             // Rd·flux would overflow (∞·0 = NaN otherwise).
             self.global[c] = self.global[c] + rd[c] * (flux[c] * one_minus_w);
             if MODE == EDGE_AWARE {
-                // N10's weights are scaled by 1/(Rd(0)·Ā) per channel, so that they are O(1)
-                // whatever the units (unscaled, Rd·A underflowed to subnormals at tiny scales
-                // and the local irradiance lost every digit).
-                let scaled = rd[c] * L::splat(self.local_scale[c]) * w;
-                self.local_flux[c] = self.local_flux[c] + scaled * flux[c];
-                self.local_weight[c] = self.local_weight[c] + scaled * area;
+                let weight = rd[c] * L::splat(self.rd_scale[c]) * w;
+                let scaled_flux = flux[c] * L::splat(self.flux_scale[c]);
+                self.local_flux[c] = self.local_flux[c] + weight * scaled_flux;
+                self.local_weight[c] = self.local_weight[c] + weight * area;
             }
         }
     }
@@ -568,7 +580,9 @@ pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
         cache,
         profile,
         kernel: params.kernel,
-        local_scale: params.local_scale,
+        rd_scale: params.rd_scale,
+        area_scale: params.area_scale,
+        flux_scale: params.flux_scale,
         x: [L::splat(x.x), L::splat(x.y), L::splat(x.z)],
         samples: Buffer::new(),
         aggregates: Buffer::new(),

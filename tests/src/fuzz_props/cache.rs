@@ -38,8 +38,10 @@
 //!    global sum, and never adds.
 //! 6. (Likewise.) With ε = 0 and t = 0 the hierarchical, local-global and edge-aware queries
 //!    equal the exhaustive sums (core's oracles, and an independent scalar f64 sum) to float
-//!    rounding — N10 included where its weights Rd·A would be subnormal in f32: the traversal
-//!    scales them by 1/(Rd(0)·Ā) (found by this target, `regress-subnormal-edge-aware-weights`).
+//!    rounding — N10 included where its weights Rd·A would be subnormal in f32 (found by this
+//!    target, `regress-subnormal-edge-aware-weights`) or Ā itself is subnormal: the traversal
+//!    scales Rd, A and E·A apart by powers of two near 1/Rd(0), 1/Ā and 1/Φ (one factor
+//!    1/(Rd(0)·Ā) overflowed Rd·factor where Ā < 2⁻¹²⁷: `crash-subnormal-mean-area-scale-overflow`).
 //!
 //! Rounding allowance: every query sums non-negative terms in f32 lanes, each lane adding at
 //! most ⌈n/8⌉ + 16 terms, so the relative error is at most about (n/8 + 16)·2⁻²⁴ (the classical
