@@ -11,7 +11,7 @@ use core::fmt;
 
 use glam::{DVec3, Vec3};
 
-use crate::cache::traverse::{EDGE_AWARE, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
+use crate::cache::traverse::{EDGE_AWARE, FLUX_HEADROOM, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
 use crate::cache::{self, IrradianceCache};
 use crate::kernel::Kernel;
 use crate::lanes::{DefaultLanes, Lanes};
@@ -214,11 +214,11 @@ impl IrradianceCache {
             return Err(QueryError::InvalidLocalIntegral);
         }
         settings.validate()?;
-        // N10's sums are scaled by powers of two near 1/Rd(0), 1/Ā and 1/Φ (see `Params`).
+        // N10's sums are scaled by powers of two near 1/Rd(0) and 1/Ā (see `Params`).
         let rd_zero = profile.rd_zero().to_array();
         let rd_scale = rd_zero.map(reciprocal_pow2);
         let area_scale = reciprocal_pow2(self.mean_area());
-        let flux_scale = self.total_flux().to_array().map(reciprocal_pow2);
+        let flux_scale = pow2_clamped(f64::from(area_scale) * f64::from(FLUX_HEADROOM));
         let params = Params {
             epsilon: settings.epsilon,
             cull_tolerance: settings.cull_tolerance,
@@ -255,15 +255,15 @@ impl IrradianceCache {
                 let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
                 // N10: the shading point joins the kernel-weighted average at r = 0 with weight
                 // Rd(0)·Ā, in (1/4, 1] in the traversal's scaled weights (0 if Ā = 0). The
-                // scaled flux sum is Σ w·Rd·E·A·(rd_scale·flux_scale): times area_scale /
-                // flux_scale (exact, in f64) it is on the weights' scale.
-                let centre = Vec3::from_array(rd_zero)
+                // scaled flux sum is Σ w·Rd·E·A·rd_scale·flux_scale: times area_scale /
+                // flux_scale (a power of two, exact in f64) it is on the weights' scale.
+                let centre = (Vec3::from_array(rd_zero)
                     * Vec3::from_array(rd_scale)
-                    * (self.mean_area() * area_scale);
-                let den = (centre + sums.local_weight).as_dvec3();
-                let unscale =
-                    Vec3::from_array(flux_scale).as_dvec3().recip() * f64::from(area_scale);
-                let num = centre.as_dvec3() * e.as_dvec3() + sums.local_flux.as_dvec3() * unscale;
+                    * (self.mean_area() * area_scale))
+                    .as_dvec3();
+                let den = centre + sums.local_weight;
+                let unscale = f64::from(area_scale) / f64::from(flux_scale);
+                let num = centre * e.as_dvec3() + sums.local_flux * unscale;
                 let e_loc = (num / den).as_vec3();
                 // With no weight at all (Ā = 0 and no samples within α) fall back to E(x).
                 let e_loc = Vec3::select(den.cmpgt(DVec3::ZERO) & e_loc.is_finite_mask(), e_loc, e);
@@ -272,6 +272,12 @@ impl IrradianceCache {
         };
         Ok(result)
     }
+}
+
+/// A power of two v (in f64) clamped to [2⁻¹²⁶, 2¹²⁶].
+fn pow2_clamped(v: f64) -> f32 {
+    let (lo, hi) = (crate::math::pow2i(-126), crate::math::pow2i(126));
+    v.clamp(f64::from(lo), f64::from(hi)) as f32
 }
 
 /// 2^−⌈log₂ v⌉ for positive finite v, clamped to [2⁻¹²⁶, 2¹²⁶] (1 for 0): v times it is in

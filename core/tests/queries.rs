@@ -621,3 +621,75 @@ fn edge_aware_local_irradiance_survives_huge_irradiance_in_a_wide_kernel() {
     let p = profile(100.0);
     assert_edge_aware_matches_f64(&samples, &p, 15.0, &plane_points(40, h, 1e37, 34), 1e-4);
 }
+
+/// Queries N10 at each of eight unlit samples spread over `spread` (x on their leaf's sphere),
+/// with one lit sample far away; returns the queries whose E_loc misses x's own weight.
+fn unlit_surface_failures(spread: f32, trials: usize, seed: u64) -> Vec<(usize, Vec3, Vec3)> {
+    let p = profile(0.5);
+    let mut rng = Rng(seed);
+    let mut failures = Vec::new();
+    for trial in 0..trials {
+        let mut samples: Vec<lucent_core::Sample> = (0..8)
+            .map(|_| lucent_core::Sample {
+                position: rng.vec3(-spread, spread),
+                area: 1.0,
+                irradiance: Vec3::ZERO,
+            })
+            .collect();
+        samples.push(lucent_core::Sample {
+            position: Vec3::splat(10.0 * spread),
+            area: 1.0,
+            irradiance: Vec3::ONE,
+        });
+        let cache = IrradianceCache::build(&samples).unwrap();
+        let alpha = cache.smoothing_radius(2.0);
+        let kk = LocalIntegralTable::new(&p, alpha, 0.0)
+            .unwrap()
+            .lookup(p.mean_free_path());
+        for s in &samples[..8] {
+            let sp = ShadingPoint {
+                position: s.position,
+                irradiance: Vec3::ONE,
+            };
+            let got = cache
+                .query(&p, &sp, kk, &settings(Method::EdgeAware, 0.0, 0.0, alpha))
+                .unwrap();
+            // Every other sample is far beyond α: E_loc = Rd(0)·Ā / (Rd(0)·Ā + Rd(0)·A).
+            let want = cache.mean_area() / (cache.mean_area() + 1.0);
+            if rel_err(got.local_irradiance, Vec3::splat(want)) > 1e-5 {
+                failures.push((trial, s.position, got.local_irradiance));
+            }
+        }
+    }
+    failures
+}
+
+/// N10 weighs the unlit samples within α of x, so a node's sphere must test as holding x when
+/// x is one of its samples, however large the sphere: the f32 distance to the centroid can
+/// exceed the (rounded-up) radius by a few ulps, which on a sphere of radius 10⁹ is ~100 units,
+/// far beyond α = 2 — the node was pruned as unlit and far, and E_loc lost x's own weight
+/// (5 of these 8000 queries, E_loc 1 instead of 1/2).
+#[test]
+fn edge_aware_weighs_unlit_samples_on_the_surface_of_a_huge_node() {
+    let failures = unlit_surface_failures(1e9, 1000, 41);
+    assert!(
+        failures.is_empty(),
+        "{} failures: {:?}",
+        failures.len(),
+        &failures[..failures.len().min(4)]
+    );
+}
+
+/// The same where the distance to the centroid squares past f32::MAX (spread 10²⁰): the
+/// squared distance was +∞, the node looked infinitely far although it holds x (found by
+/// fuzzing, `crash-centroid-distance-squared-overflows`).
+#[test]
+fn edge_aware_weighs_unlit_samples_of_a_node_beyond_f32_squares() {
+    let failures = unlit_surface_failures(1e20, 50, 42);
+    assert!(
+        failures.is_empty(),
+        "{} failures: {:?}",
+        failures.len(),
+        &failures[..failures.len().min(4)]
+    );
+}

@@ -193,15 +193,6 @@ impl IrradianceCache {
             self.nodes.area[0]
         }
     }
-    /// Total flux Σ E_i·A_i per channel.
-    pub fn total_flux(&self) -> Vec3 {
-        if self.node_len == 0 {
-            Vec3::ZERO
-        } else {
-            let n = &self.nodes;
-            Vec3::new(n.flux_r[0], n.flux_g[0], n.flux_b[0])
-        }
-    }
     /// Bounds of all samples (`None` when empty).
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         self.bounds
