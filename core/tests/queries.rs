@@ -629,15 +629,26 @@ fn unlit_surface_failures(spread: f32, trials: usize, seed: u64) -> Vec<(usize, 
     let mut rng = Rng(seed);
     let mut failures = Vec::new();
     for trial in 0..trials {
+        // Near ±f32::MAX: corners of the cube (random signs), so that the sphere saturates.
+        let mut position = || {
+            if spread > 1e38 {
+                let c = |r: &mut Rng| {
+                    r.range(0.9, 1.0) * spread * if r.f32() < 0.5 { -1.0 } else { 1.0 }
+                };
+                Vec3::new(c(&mut rng), c(&mut rng), c(&mut rng))
+            } else {
+                rng.vec3(-spread, spread)
+            }
+        };
         let mut samples: Vec<lucent_core::Sample> = (0..8)
             .map(|_| lucent_core::Sample {
-                position: rng.vec3(-spread, spread),
+                position: position(),
                 area: 1.0,
                 irradiance: Vec3::ZERO,
             })
             .collect();
         samples.push(lucent_core::Sample {
-            position: Vec3::splat(10.0 * spread),
+            position: Vec3::splat((10.0 * spread).min(3.3e38)),
             area: 1.0,
             irradiance: Vec3::ONE,
         });
@@ -686,6 +697,20 @@ fn edge_aware_weighs_unlit_samples_on_the_surface_of_a_huge_node() {
 #[test]
 fn edge_aware_weighs_unlit_samples_of_a_node_beyond_f32_squares() {
     let failures = unlit_surface_failures(1e20, 50, 42);
+    assert!(
+        failures.is_empty(),
+        "{} failures: {:?}",
+        failures.len(),
+        &failures[..failures.len().min(4)]
+    );
+}
+
+/// The same near ±f32::MAX (spread 3.2·10³⁸): the offsets to the centroids overflow too, and
+/// the root's radius saturates at f32::MAX, which stands for an unbounded sphere (found by
+/// fuzzing, `crash-unbounded-root-near-f32-max`).
+#[test]
+fn edge_aware_weighs_unlit_samples_near_f32_max() {
+    let failures = unlit_surface_failures(3.2e38, 50, 43);
     assert!(
         failures.is_empty(),
         "{} failures: {:?}",

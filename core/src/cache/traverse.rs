@@ -425,16 +425,21 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
             let cz = load(&nodes.centroid_z) - xz;
             let dist2 = cx * cx + cy * cy + cz * cz;
             let mut dist = dist2.sqrt();
+            let radius = load(&nodes.radius);
             let overflowed = !dist2.lt(L::splat(f32::INFINITY));
             if overflowed.any() {
                 // Centroids beyond ~1.8e19 square to +∞ (Rd is 0 there, but the node's sphere
-                // may still hold x): their distance again, through offsets scaled by 2⁻⁶⁴.
+                // may still hold x): their distance again, through coordinates scaled by 2⁻⁶⁴
+                // (the offsets themselves can overflow near ±f32::MAX). A radius of f32::MAX
+                // stands for a sphere too large for f32 (see `validate`): it holds x.
                 let s = L::splat(SQUARE_SCALE);
-                let (sx, sy, sz) = (cx * s, cy * s, cz * s);
+                let sx = load(&nodes.centroid_x) * s - xx * s;
+                let sy = load(&nodes.centroid_y) * s - xy * s;
+                let sz = load(&nodes.centroid_z) * s - xz * s;
                 let scaled = (sx * sx + sy * sy + sz * sz).sqrt() * L::splat(1.0 / SQUARE_SCALE);
-                dist = dist.keep(!overflowed) + scaled.keep(overflowed);
+                let bounded = radius.lt(L::splat(f32::MAX));
+                dist = dist.keep(!overflowed) + scaled.keep(overflowed & bounded);
             }
-            let radius = load(&nodes.radius);
             // A lower bound of the gap to the sphere (the radius is rounded up; `dist` is within
             // 2⁻²² of the exact distance): x on a large sphere's surface must test as inside,
             // or an unlit node holding x is pruned from N10's weights.
