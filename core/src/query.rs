@@ -9,9 +9,9 @@
 
 use core::fmt;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
-use crate::cache::traverse::{EDGE_AWARE, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
+use crate::cache::traverse::{EDGE_AWARE, FLUX_HEADROOM, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
 use crate::cache::{self, IrradianceCache};
 use crate::kernel::Kernel;
 use crate::lanes::{DefaultLanes, Lanes};
@@ -214,16 +214,19 @@ impl IrradianceCache {
             return Err(QueryError::InvalidLocalIntegral);
         }
         settings.validate()?;
-        // N10's weights are scaled by 1/(Rd(0)·Ā) per channel (see `Params::local_scale`).
-        let centre = (profile.rd_zero().as_dvec3() * self.mean_area() as f64).to_array();
-        let local_scale =
-            centre.map(|c| (1.0 / c).clamp(f32::MIN_POSITIVE as f64, f32::MAX as f64) as f32);
+        // N10's sums are scaled by powers of two near 1/Rd(0) and 1/Ā (see `Params`).
+        let rd_zero = profile.rd_zero().to_array();
+        let rd_scale = rd_zero.map(reciprocal_pow2);
+        let area_scale = reciprocal_pow2(self.mean_area());
+        let flux_scale = pow2_clamped(f64::from(area_scale) * f64::from(FLUX_HEADROOM));
         let params = Params {
             epsilon: settings.epsilon,
             cull_tolerance: settings.cull_tolerance,
             kernel: Kernel::new(settings.smoothing_radius),
             irradiance: point.irradiance,
-            local_scale,
+            rd_scale,
+            area_scale,
+            flux_scale,
         };
         let x = point.position;
         let e = point.irradiance;
@@ -251,21 +254,44 @@ impl IrradianceCache {
             Method::EdgeAware => {
                 let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
                 // N10: the shading point joins the kernel-weighted average at r = 0 with weight
-                // Rd(0)·Ā, which is ≈ 1 in the scaled weights of the traversal.
-                let centre = Vec3::new(
-                    (centre[0] * local_scale[0] as f64) as f32,
-                    (centre[1] * local_scale[1] as f64) as f32,
-                    (centre[2] * local_scale[2] as f64) as f32,
-                );
+                // Rd(0)·Ā, in (1/4, 1] in the traversal's scaled weights (0 if Ā = 0). The
+                // scaled flux sum is Σ w·Rd·E·A·rd_scale·flux_scale: times area_scale /
+                // flux_scale (a power of two, exact in f64) it is on the weights' scale.
+                let centre = (Vec3::from_array(rd_zero)
+                    * Vec3::from_array(rd_scale)
+                    * (self.mean_area() * area_scale))
+                    .as_dvec3();
                 let den = centre + sums.local_weight;
-                let e_loc = (centre * e + sums.local_flux) / den;
+                let unscale = f64::from(area_scale) / f64::from(flux_scale);
+                let num = centre * e.as_dvec3() + sums.local_flux * unscale;
+                let e_loc = (num / den).as_vec3();
                 // With no weight at all (Ā = 0 and no samples within α) fall back to E(x).
-                let e_loc = Vec3::select(den.cmpgt(Vec3::ZERO) & e_loc.is_finite_mask(), e_loc, e);
+                let e_loc = Vec3::select(den.cmpgt(DVec3::ZERO) & e_loc.is_finite_mask(), e_loc, e);
                 split_result(sums, e_loc, local_integral)
             }
         };
         Ok(result)
     }
+}
+
+/// A power of two v (in f64) clamped to [2⁻¹²⁶, 2¹²⁶].
+fn pow2_clamped(v: f64) -> f32 {
+    let (lo, hi) = (crate::math::pow2i(-126), crate::math::pow2i(126));
+    v.clamp(f64::from(lo), f64::from(hi)) as f32
+}
+
+/// 2^−⌈log₂ v⌉ for positive finite v, clamped to [2⁻¹²⁶, 2¹²⁶] (1 for 0): v times it is in
+/// (1/2, 1] unless v is subnormal (then below 1) or above 2¹²⁶ (then below 4). Scaling by a
+/// power of two is exact, so N10's scaled sums lose no digits to it.
+fn reciprocal_pow2(v: f32) -> f32 {
+    if !(v > 0.0 && v.is_finite()) {
+        return 1.0;
+    }
+    // Through f64, where every positive f32 (subnormals included) is normal.
+    let bits = f64::from(v).to_bits();
+    let floor = ((bits >> 52) & 0x7ff) as i32 - 1023;
+    let ceil = floor + i32::from(bits & ((1 << 52) - 1) != 0);
+    crate::math::pow2i((-ceil).clamp(-126, 126))
 }
 
 fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {

@@ -240,3 +240,36 @@ fn samples_round_trip_through_the_cache() {
         }
     }
 }
+
+/// Samples near ±f32::MAX: a node's sphere is then too large for f32 and its radius saturates
+/// at f32::MAX ("unbounded"); `validate()` allowed that for the samples but not for the child
+/// centroids, and rejected the cache (found by fuzzing, `crash-saturated-radius-child-centroid`).
+#[test]
+fn corners_near_f32_max_validate() {
+    let m = 3.19e38;
+    let mut samples = Vec::new();
+    for (i, (x, y, z)) in [
+        (-m, -m, 0.67 * m),
+        (-m, -m, -m),
+        (-m, 0.52 * m, -m),
+        (-m, m, m),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        for copy in 0..3 {
+            samples.push(Sample {
+                position: Vec3::new(x, y, z),
+                area: 2.5e27,
+                irradiance: Vec3::splat(if copy == 0 && i == 3 { 1.0 } else { 0.0 }),
+            });
+        }
+    }
+    samples.push(Sample {
+        position: Vec3::ZERO,
+        area: 0.0,
+        irradiance: Vec3::ZERO,
+    });
+    let cache = IrradianceCache::build(&samples).unwrap();
+    cache.validate().unwrap();
+}

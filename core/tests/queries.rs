@@ -500,3 +500,221 @@ fn edge_aware_local_irradiance_stays_accurate_when_its_weights_are_tiny() {
         );
     }
 }
+
+/// A jittered square grid of `n`² samples of spacing `h` on the plane z = 0, centred on the
+/// origin, with irradiance `e` times a per-sample factor in [0.5, 1.5] per channel.
+fn jittered_plane(n: usize, h: f32, e: f32, seed: u64) -> Vec<lucent_core::Sample> {
+    let mut rng = Rng(seed);
+    let half = n as f32 * h / 2.0;
+    let mut samples = Vec::with_capacity(n * n);
+    for i in 0..n {
+        for j in 0..n {
+            let u = (i as f32 + rng.range(0.0, 1.0)) * h - half;
+            let v = (j as f32 + rng.range(0.0, 1.0)) * h - half;
+            samples.push(lucent_core::Sample {
+                position: Vec3::new(u, v, 0.0),
+                area: h * h * rng.range(0.5, 1.5),
+                irradiance: rng.vec3(0.5, 1.5) * e,
+            });
+        }
+    }
+    samples
+}
+
+/// N10's local irradiance against its formula in double precision (reference sheet §6a):
+/// E_loc = [Rd(0) Ā E(x) + Σ w Rd A E] / [Rd(0) Ā + Σ w Rd A], within `tolerance` (relative),
+/// and the whole edge-aware result against `exhaustive_edge_aware`.
+fn assert_edge_aware_matches_f64(
+    samples: &[lucent_core::Sample],
+    p: &Profile,
+    k: f32,
+    points: &[ShadingPoint],
+    tolerance: f32,
+) {
+    let cache = IrradianceCache::build(samples).unwrap();
+    cache.validate().unwrap();
+    let centre = p.rd_zero().as_dvec3() * cache.mean_area() as f64;
+    let alpha = cache.smoothing_radius(k);
+    let kernel = lucent_core::Kernel::new(alpha);
+    let kk = LocalIntegralTable::new(p, alpha, 0.0)
+        .unwrap()
+        .lookup(p.mean_free_path());
+    for sp in points {
+        let (x, e) = (sp.position, sp.irradiance);
+        let (mut num, mut den) = (centre * e.as_dvec3(), centre);
+        for s in cache.samples() {
+            let r2 = (s.position - x).length_squared();
+            let wrd = p.rd(r2).as_dvec3() * kernel.weight(r2) as f64 * s.area as f64;
+            num += wrd * s.irradiance.as_dvec3();
+            den += wrd;
+        }
+        let want = (num / den).as_vec3();
+        let got = cache
+            .query(p, sp, kk, &settings(Method::EdgeAware, 0.0, 0.0, alpha))
+            .unwrap();
+        assert!(got.total.is_finite(), "at {x}: {got:?}");
+        let error = rel_err(got.local_irradiance, want);
+        assert!(
+            error < tolerance,
+            "at {x}: E_loc {} vs {want}",
+            got.local_irradiance
+        );
+        let oracle = exhaustive_edge_aware(&cache, p, x, e, kk, alpha);
+        assert!(
+            rel_err(got.total, oracle) < tolerance,
+            "at {x}: {} vs exhaustive {oracle}",
+            got.total
+        );
+    }
+}
+
+/// Shading points at, near and between the samples of `jittered_plane(n, h, ..)`, with
+/// irradiance `e` at x (0 for every other point: E_loc must then come from the cache alone).
+fn plane_points(n: usize, h: f32, e: f32, seed: u64) -> Vec<ShadingPoint> {
+    let mut rng = Rng(seed);
+    let half = n as f32 * h / 2.0;
+    (0..40)
+        .map(|i| ShadingPoint {
+            position: Vec3::new(rng.range(-half, half), rng.range(-half, half), 0.0),
+            irradiance: if i % 2 == 0 {
+                Vec3::ZERO
+            } else {
+                rng.vec3(0.5, 1.5) * e
+            },
+        })
+        .collect()
+}
+
+/// N10's weights are scaled by powers of two near 1/Rd(0) and 1/Ā, each on its own: where Ā
+/// is subnormal (< 2⁻¹²⁶; here a plane of spacing 2⁻⁶⁴, Ā ≈ 2⁻¹²⁸) a single factor
+/// 1/(Rd(0)·Ā) made Rd·factor overflow to +∞, E_loc became ∞/∞ and fell back to E(x) — found
+/// by fuzzing (`crash-subnormal-mean-area-scale-overflow`: one sample of area 2⁻¹²⁸ at x,
+/// E_loc 0 instead of E/2).
+#[test]
+fn edge_aware_local_irradiance_survives_a_subnormal_mean_area() {
+    let h = 2f32.powi(-64);
+    let samples = jittered_plane(32, h, 1.0, 31);
+    let cache = IrradianceCache::build(&samples).unwrap();
+    assert!(
+        cache.mean_area() < f32::MIN_POSITIVE,
+        "the test needs a subnormal mean area, got {}",
+        cache.mean_area()
+    );
+    // α = 8·√Ā ≈ 8 spacings: above the 1.1e-19 below which the kernel acts as α = 0, so that
+    // about 200 samples weigh E_loc. ℓ_u near the smallest the dipole represents (Rd is
+    // nearly flat over α).
+    let k = 8.0;
+    assert!(cache.smoothing_radius(k) > 2e-19);
+    let p = profile(1e-12);
+    assert_edge_aware_matches_f64(&samples, &p, k, &plane_points(32, h, 1.0, 32), 1e-4);
+}
+
+/// The scaled local flux sum is also kept ≤ 1 (scaled by a power of two near 1/Φ): scaled by
+/// 1/(Rd(0)·Ā) alone, it is about Σ w·E over the α-ball, and irradiances near 10³⁷ over the
+/// ~700 samples of a wide α-ball overflowed f32, although E_loc itself (a weighted mean of
+/// the irradiances) is representable.
+#[test]
+fn edge_aware_local_irradiance_survives_huge_irradiance_in_a_wide_kernel() {
+    let h = 0.1;
+    let samples = jittered_plane(40, h, 1e37, 33);
+    // ℓ_u far beyond α = 1.5: Rd is nearly Rd(0) over the whole α-ball.
+    let p = profile(100.0);
+    assert_edge_aware_matches_f64(&samples, &p, 15.0, &plane_points(40, h, 1e37, 34), 1e-4);
+}
+
+/// Queries N10 at each of eight unlit samples spread over `spread` (x on their leaf's sphere),
+/// with one lit sample far away; returns the queries whose E_loc misses x's own weight.
+fn unlit_surface_failures(spread: f32, trials: usize, seed: u64) -> Vec<(usize, Vec3, Vec3)> {
+    let p = profile(0.5);
+    let mut rng = Rng(seed);
+    let mut failures = Vec::new();
+    for trial in 0..trials {
+        // Near ±f32::MAX: corners of the cube (random signs), so that the sphere saturates.
+        let mut position = || {
+            if spread > 1e38 {
+                let c = |r: &mut Rng| {
+                    r.range(0.9, 1.0) * spread * if r.f32() < 0.5 { -1.0 } else { 1.0 }
+                };
+                Vec3::new(c(&mut rng), c(&mut rng), c(&mut rng))
+            } else {
+                rng.vec3(-spread, spread)
+            }
+        };
+        let mut samples: Vec<lucent_core::Sample> = (0..8)
+            .map(|_| lucent_core::Sample {
+                position: position(),
+                area: 1.0,
+                irradiance: Vec3::ZERO,
+            })
+            .collect();
+        samples.push(lucent_core::Sample {
+            position: Vec3::splat((10.0 * spread).min(3.3e38)),
+            area: 1.0,
+            irradiance: Vec3::ONE,
+        });
+        let cache = IrradianceCache::build(&samples).unwrap();
+        let alpha = cache.smoothing_radius(2.0);
+        let kk = LocalIntegralTable::new(&p, alpha, 0.0)
+            .unwrap()
+            .lookup(p.mean_free_path());
+        for s in &samples[..8] {
+            let sp = ShadingPoint {
+                position: s.position,
+                irradiance: Vec3::ONE,
+            };
+            let got = cache
+                .query(&p, &sp, kk, &settings(Method::EdgeAware, 0.0, 0.0, alpha))
+                .unwrap();
+            // Every other sample is far beyond α: E_loc = Rd(0)·Ā / (Rd(0)·Ā + Rd(0)·A).
+            let want = cache.mean_area() / (cache.mean_area() + 1.0);
+            if rel_err(got.local_irradiance, Vec3::splat(want)) > 1e-5 {
+                failures.push((trial, s.position, got.local_irradiance));
+            }
+        }
+    }
+    failures
+}
+
+/// N10 weighs the unlit samples within α of x, so a node's sphere must test as holding x when
+/// x is one of its samples, however large the sphere: the f32 distance to the centroid can
+/// exceed the (rounded-up) radius by a few ulps, which on a sphere of radius 10⁹ is ~100 units,
+/// far beyond α = 2 — the node was pruned as unlit and far, and E_loc lost x's own weight
+/// (5 of these 8000 queries, E_loc 1 instead of 1/2).
+#[test]
+fn edge_aware_weighs_unlit_samples_on_the_surface_of_a_huge_node() {
+    let failures = unlit_surface_failures(1e9, 1000, 41);
+    assert!(
+        failures.is_empty(),
+        "{} failures: {:?}",
+        failures.len(),
+        &failures[..failures.len().min(4)]
+    );
+}
+
+/// The same where the distance to the centroid squares past f32::MAX (spread 10²⁰): the
+/// squared distance was +∞, the node looked infinitely far although it holds x (found by
+/// fuzzing, `crash-centroid-distance-squared-overflows`).
+#[test]
+fn edge_aware_weighs_unlit_samples_of_a_node_beyond_f32_squares() {
+    let failures = unlit_surface_failures(1e20, 50, 42);
+    assert!(
+        failures.is_empty(),
+        "{} failures: {:?}",
+        failures.len(),
+        &failures[..failures.len().min(4)]
+    );
+}
+
+/// The same near ±f32::MAX (spread 3.2·10³⁸): the offsets to the centroids overflow too, and
+/// the root's radius saturates at f32::MAX, which stands for an unbounded sphere (found by
+/// fuzzing, `crash-unbounded-root-near-f32-max`).
+#[test]
+fn edge_aware_weighs_unlit_samples_near_f32_max() {
+    let failures = unlit_surface_failures(3.2e38, 50, 43);
+    assert!(
+        failures.is_empty(),
+        "{} failures: {:?}",
+        failures.len(),
+        &failures[..failures.len().min(4)]
+    );
+}

@@ -5,7 +5,8 @@
 //! examines all its children at once in 8 lanes:
 //!
 //! 1. distance from x to each child's centroid P and to its bounding sphere about P (`dmin2`,
-//!    0 inside);
+//!    0 inside), a lower bound of the exact gap (rounding and overflow of |x − P|² included:
+//!    a node holding x must never look far from it);
 //! 2. **prune** children without flux (unlit, shadowed): they add nothing. N10 needs the area
 //!    of those touching the α-ball for its local weight — but only if the local irradiance can
 //!    be non-zero, so they are *deferred* and visited at the end only if E(x) or the local
@@ -64,7 +65,7 @@
 //! entirely beyond α skip the kernel. Modes are const generics, so each is compiled without the
 //! others' work.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::{COUNT_MASK, IrradianceCache, LEAF_BIT, MAX_DEPTH};
 use crate::kernel::Kernel;
@@ -90,6 +91,12 @@ const DEFERRED: usize = 64;
 /// lanes differed from the exhaustive sum by 1.7e-4).
 const FOLD_BATCHES: u32 = 32;
 
+/// 2⁻⁶⁴: offsets this much smaller square without overflow (see `descend`).
+const SQUARE_SCALE: f32 = 1.0 / 18_446_744_073_709_551_616.0;
+/// 1 − 2⁻²⁰: a computed distance times this is at most the exact one (the f32 distance is
+/// within about 4·2⁻²⁴ of it: one rounding per difference, square, sum and the root).
+const DIST_LOWER: f32 = 1.0 - 1.0 / 1_048_576.0;
+
 /// Traversal parameters (validated by the caller).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Params {
@@ -98,19 +105,30 @@ pub(crate) struct Params {
     pub kernel: Kernel,
     /// E(x): decides whether N10's deferred unlit subtrees matter.
     pub irradiance: Vec3,
-    /// N10: per channel 1/(Rd(0)·Ā) (clamped into the f32 range), the scale of its weights.
-    pub local_scale: [f32; 3],
+    /// N10: per channel a power of two at most 1/Rd(0), so that Rd·`rd_scale` ≤ 1.
+    pub rd_scale: [f32; 3],
+    /// N10: a power of two at most 1/Ā, so that A·`area_scale` ≤ A/Ā.
+    pub area_scale: f32,
+    /// N10: `area_scale` times [`FLUX_HEADROOM`] (a power of two, clamped into f32's normal
+    /// range), so that no single flux term E·A/Ā can overflow.
+    pub flux_scale: f32,
 }
+
+/// N10's flux terms are scaled by this beyond 1/Ā: E·A/Ā itself can exceed f32 (E near
+/// f32::MAX on a sample larger than the mean), E·A/Ā·2⁻³² cannot (A/Ā ≤ n < 2³¹). Terms lose
+/// digits only below about 2⁻⁹⁴ of E's unit, where they are negligible.
+pub(crate) const FLUX_HEADROOM: f32 = 1.0 / 4_294_967_296.0;
 
 /// What a traversal returns, per channel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Sums {
     /// Σ Rd·E·A (hierarchical) or Σ (1 − w)·Rd·E·A (split modes).
     pub global: Vec3,
-    /// N10: Σ w·Rd·E·A, scaled by `Params::local_scale`.
-    pub local_flux: Vec3,
-    /// N10: Σ w·Rd·A, scaled by `Params::local_scale`.
-    pub local_weight: Vec3,
+    /// N10: Σ w·Rd·E·A, scaled by `Params::rd_scale` and `Params::flux_scale` (kept in
+    /// double precision: the sum of many terms near f32::MAX·2⁻³² must not overflow).
+    pub local_flux: DVec3,
+    /// N10: Σ w·Rd·A, scaled by `Params::rd_scale` and `Params::area_scale`.
+    pub local_weight: DVec3,
 }
 
 /// For each 8-bit lane mask, its set lanes in increasing order (then zeros).
@@ -199,7 +217,9 @@ struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     cache: &'a IrradianceCache,
     profile: &'a Profile,
     kernel: Kernel,
-    local_scale: [f32; 3],
+    rd_scale: [f32; 3],
+    area_scale: f32,
+    flux_scale: f32,
     x: [L; 3],
     /// Sample terms: r², flux r g b, area.
     samples: Buffer<5>,
@@ -252,13 +272,13 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
     }
 
     /// A running total per channel (folded plus lanes): 0 = global, 1 = local flux.
-    fn running(&self, which: usize) -> [f32; 3] {
+    fn running(&self, which: usize) -> [f64; 3] {
         let lanes = if which == 0 {
             &self.global
         } else {
             &self.local_flux
         };
-        core::array::from_fn(|c| (self.folded[which][c] + lanes[c].reduce_add() as f64) as f32)
+        core::array::from_fn(|c| self.folded[which][c] + lanes[c].reduce_add() as f64)
     }
 
     /// Evaluates the first `n ≤ 8` sample terms.
@@ -281,18 +301,22 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         }
         let w = self.kernel.weight_lanes(r2);
         let one_minus_w = L::splat(1.0) - w;
-        let area = area.keep(valid);
+        // N10's sums are scaled so that they stay near the unit whatever the units: the
+        // weight w·Rd·A as w·(Rd/Rd(0))·(A/Ā), its flux as w·(Rd/Rd(0))·(E·A/Ā)·2⁻³². Unscaled,
+        // Rd·A underflowed to subnormals at tiny scales and the local irradiance lost every
+        // digit. Each factor is scaled on its own, by a power of two (exact, see `Params`):
+        // one combined factor 1/(Rd(0)·Ā) overflowed Rd·factor to +∞ where Ā < 2⁻¹²⁷ (∞/∞ =
+        // NaN, and E_loc fell back to E(x)).
+        let area = area.keep(valid) * L::splat(self.area_scale);
+        let flux_scale = L::splat(self.flux_scale);
         for c in 0..3 {
             // The kernel factor multiplies the flux first: where it is 0, a term is 0 even if
             // Rd·flux would overflow (∞·0 = NaN otherwise).
             self.global[c] = self.global[c] + rd[c] * (flux[c] * one_minus_w);
             if MODE == EDGE_AWARE {
-                // N10's weights are scaled by 1/(Rd(0)·Ā) per channel, so that they are O(1)
-                // whatever the units (unscaled, Rd·A underflowed to subnormals at tiny scales
-                // and the local irradiance lost every digit).
-                let scaled = rd[c] * L::splat(self.local_scale[c]) * w;
-                self.local_flux[c] = self.local_flux[c] + scaled * flux[c];
-                self.local_weight[c] = self.local_weight[c] + scaled * area;
+                let weight = rd[c] * L::splat(self.rd_scale[c]) * w;
+                self.local_flux[c] = self.local_flux[c] + weight * (flux[c] * flux_scale);
+                self.local_weight[c] = self.local_weight[c] + weight * area;
             }
         }
     }
@@ -400,9 +424,26 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
             let cy = load(&nodes.centroid_y) - xy;
             let cz = load(&nodes.centroid_z) - xz;
             let dist2 = cx * cx + cy * cy + cz * cz;
-            let dist = dist2.sqrt();
+            let mut dist = dist2.sqrt();
             let radius = load(&nodes.radius);
-            let gap = (dist - radius).max(zero);
+            let overflowed = !dist2.lt(L::splat(f32::INFINITY));
+            if overflowed.any() {
+                // Centroids beyond ~1.8e19 square to +∞ (Rd is 0 there, but the node's sphere
+                // may still hold x): their distance again, through coordinates scaled by 2⁻⁶⁴
+                // (the offsets themselves can overflow near ±f32::MAX). A radius of f32::MAX
+                // stands for a sphere too large for f32 (see `validate`): it holds x.
+                let s = L::splat(SQUARE_SCALE);
+                let sx = load(&nodes.centroid_x) * s - xx * s;
+                let sy = load(&nodes.centroid_y) * s - xy * s;
+                let sz = load(&nodes.centroid_z) * s - xz * s;
+                let scaled = (sx * sx + sy * sy + sz * sz).sqrt() * L::splat(1.0 / SQUARE_SCALE);
+                let bounded = radius.lt(L::splat(f32::MAX));
+                dist = dist.keep(!overflowed) + scaled.keep(overflowed & bounded);
+            }
+            // A lower bound of the gap to the sphere (the radius is rounded up; `dist` is within
+            // 2⁻²² of the exact distance): x on a large sphere's surface must test as inside,
+            // or an unlit node holding x is pruned from N10's weights.
+            let gap = (dist * L::splat(DIST_LOWER) - radius).max(zero);
             let dmin2 = gap * gap;
             let flux = [
                 load(&nodes.flux_r),
@@ -435,7 +476,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
             }
 
             let area = load(&nodes.area);
-            let outside = radius.lt(dist);
+            let outside = radius.lt(dist * L::splat(DIST_LOWER));
             let small = area.lt(eps * dist2);
             let aggregate = live & outside & !near & small;
             if aggregate.any() {
@@ -474,7 +515,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
             }
             let cullable = open & !near & cull_from2.lt(dmin2);
             if tolerance > 0.0 && cullable.any() {
-                let running = self.running(0);
+                let running = self.running(0).map(|r| r as f32);
                 if running.iter().any(|&r| r > 0.0) {
                     // Area-budgeted bound: Rd(dmin)·flux ≤ tol · running · A_node / A_total.
                     let bound = self.profile.rd_lanes(dmin2);
@@ -568,7 +609,9 @@ pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
         cache,
         profile,
         kernel: params.kernel,
-        local_scale: params.local_scale,
+        rd_scale: params.rd_scale,
+        area_scale: params.area_scale,
+        flux_scale: params.flux_scale,
         x: [L::splat(x.x), L::splat(x.y), L::splat(x.z)],
         samples: Buffer::new(),
         aggregates: Buffer::new(),
@@ -583,11 +626,9 @@ pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
     };
     walker.run(params);
     walker.fold();
-    let [global, local_flux, local_weight] = walker
-        .folded
-        .map(|t| Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32));
+    let [global, local_flux, local_weight] = walker.folded.map(DVec3::from_array);
     Sums {
-        global,
+        global: global.as_vec3(),
         local_flux,
         local_weight,
     }

@@ -208,10 +208,12 @@ impl IrradianceCache {
                     flux[0] += d.flux_r[c] as f64;
                     flux[1] += d.flux_g[c] as f64;
                     flux[2] += d.flux_b[c] as f64;
-                    // A child's centroid lies within its parent's sphere.
+                    // A child's centroid lies within its parent's sphere (unless that is
+                    // unbounded: a radius of f32::MAX, as below).
                     let offset = (centroid(c).as_dvec3() - centroid(i).as_dvec3()).length();
                     ensure!(
-                        offset <= (d.radius[i] as f64) * (1.0 + 1e-5) + 1e-30,
+                        offset <= (d.radius[i] as f64) * (1.0 + 1e-5) + 1e-30
+                            || d.radius[i] == f32::MAX,
                         "node {i}: child {c}'s centroid is outside the node's sphere"
                     );
                 }

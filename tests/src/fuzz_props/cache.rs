@@ -38,8 +38,13 @@
 //!    global sum, and never adds.
 //! 6. (Likewise.) With ε = 0 and t = 0 the hierarchical, local-global and edge-aware queries
 //!    equal the exhaustive sums (core's oracles, and an independent scalar f64 sum) to float
-//!    rounding — N10 included where its weights Rd·A would be subnormal in f32: the traversal
-//!    scales them by 1/(Rd(0)·Ā) (found by this target, `regress-subnormal-edge-aware-weights`).
+//!    rounding — N10 included where its weights Rd·A would be subnormal in f32 (found by this
+//!    target, `regress-subnormal-edge-aware-weights`) or Ā itself is subnormal: the traversal
+//!    scales Rd and A apart by powers of two near 1/Rd(0) and 1/Ā (one factor 1/(Rd(0)·Ā)
+//!    overflowed Rd·factor where Ā < 2⁻¹²⁷: `crash-subnormal-mean-area-scale-overflow`); and
+//!    where x lies in a node whose centroid is beyond 1.8·10¹⁹, whose squared distance
+//!    overflows (`crash-centroid-distance-squared-overflows`: the unlit node holding x was
+//!    pruned as far, and E_loc lost x's own sample).
 //!
 //! Rounding allowance: every query sums non-negative terms in f32 lanes, each lane adding at
 //! most ⌈n/8⌉ + 16 terms, so the relative error is at most about (n/8 + 16)·2⁻²⁴ (the classical
