@@ -434,9 +434,10 @@ seed = {seed}
 
 /// Per-sample (Voronoi) areas make the exitance of a uniformly lit plane exact in the mean:
 /// marble (the default scene's material) at the default scene's sample density, normal
-/// incidence, two seeds at 24² pixels over the middle 2 units. With equal areas (total / N)
-/// the plane's border holds more samples than its share and every method sat 0.37–0.44% low;
-/// the per-pixel noise of the split methods' global sum falls to about 0.4 of what it was.
+/// incidence, two seeds at 24² pixels over the middle 2 units: within 0.002% of E·Rd_total,
+/// against −0.076% with equal areas (total / N; −0.37 to −0.44% before the elimination ran
+/// in tiles, when the plane's border held more samples than its share), and the per-pixel
+/// noise of the split methods' global sum falls to about 0.44 of what it was.
 /// The split methods compute the local term with exact K at every point
 /// (`exact_local_integral`), and the clusters use ε = 0.05 (ε = 0.5 adds a −0.25% cluster
 /// error that hierarchical shares), so what is measured is the quadrature of the sums.
@@ -465,9 +466,12 @@ fn voronoi_areas_make_a_uniform_plane_exact() {
             "{method}: mean exitance off by {:.3}%",
             bias * 100.0
         );
+        // Equal areas leave the density fluctuations of the set in the sum: measured −0.076%
+        // with the tiled elimination against +0.002% with cell areas.
         assert!(
-            equal_bias < -0.002,
-            "{method}: equal areas {:.3}%: the test no longer sees the border bias",
+            equal_bias.abs() > 4.0 * bias.abs() && bias.abs() < 0.0005,
+            "{method}: mean exitance off by {:.4}% with Voronoi areas, {:.4}% with equal areas",
+            bias * 100.0,
             equal_bias * 100.0
         );
         assert!(
