@@ -141,24 +141,44 @@ pub fn light_samples(
 /// Builds one cache per object's samples.
 pub fn build_caches(sets: &[ObjectSamples]) -> Result<Vec<IrradianceCache>, RenderError> {
     sets.iter()
-        .map(|s| {
-            let samples: Vec<Sample> = (0..s.len())
-                .map(|i| Sample {
-                    position: s.positions[i],
-                    area: s.areas[i],
-                    irradiance: s.irradiance[i],
-                })
-                .collect();
-            // Samples are validated where they are made (placement, lights, the PLY reader),
-            // so what the build can still reject is sums beyond f32: a scene far too large or
-            // lights far too bright. That is a limit of the input, not an internal error.
-            IrradianceCache::build(&samples).map_err(|e| {
-                RenderError::Limit(format!(
-                    "the irradiance samples of object {} exceed single precision: {e} (scene \
-                     too large, or lights too bright?)",
-                    s.object
-                ))
-            })
+        .map(|s| build_cache(s.object, &cache_samples(s)))
+        .collect()
+}
+
+/// [`build_caches`], releasing each object's samples as its cache is built, so that a render
+/// never holds a set, its copy for the build and the cache at once (40 bytes per sample less at
+/// the peak). Returns each cache with its object's index.
+pub fn build_caches_releasing(
+    sets: Vec<ObjectSamples>,
+) -> Result<Vec<(usize, IrradianceCache)>, RenderError> {
+    sets.into_iter()
+        .map(|set| {
+            let samples = cache_samples(&set);
+            let object = set.object;
+            drop(set);
+            Ok((object, build_cache(object, &samples)?))
         })
         .collect()
+}
+
+fn cache_samples(s: &ObjectSamples) -> Vec<Sample> {
+    (0..s.len())
+        .map(|i| Sample {
+            position: s.positions[i],
+            area: s.areas[i],
+            irradiance: s.irradiance[i],
+        })
+        .collect()
+}
+
+fn build_cache(object: usize, samples: &[Sample]) -> Result<IrradianceCache, RenderError> {
+    // Samples are validated where they are made (placement, lights, the PLY reader), so what
+    // the build can still reject is sums beyond f32: a scene far too large or lights far too
+    // bright. That is a limit of the input, not an internal error.
+    IrradianceCache::build(samples).map_err(|e| {
+        RenderError::Limit(format!(
+            "the irradiance samples of object {object} exceed single precision: {e} (scene too \
+             large, or lights too bright?)"
+        ))
+    })
 }

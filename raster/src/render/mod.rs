@@ -18,6 +18,7 @@ mod irradiance;
 mod prepare;
 mod shading;
 
+use std::borrow::Cow;
 use std::fmt;
 use std::time::{Duration, Instant};
 
@@ -279,12 +280,12 @@ fn render_in_pool(
         .map(|b| b.iter().map(ObjectSamples::len).sum());
     let plan = density::plan(&prep, settings, baked_count)?;
     let warning = warn_once(options.warn, plan.as_ref(), scene);
-    let sets = match (options.baked, &plan) {
+    let sets: Cow<[ObjectSamples]> = match (options.baked, &plan) {
         (Some(baked), _) => {
             baked::check_fits(&prep, baked)?;
-            baked.to_vec()
+            Cow::Borrowed(baked)
         }
-        (None, None) => Vec::new(),
+        (None, None) => Cow::Owned(Vec::new()),
         (None, Some(plan)) => {
             let t = Instant::now();
             let b = bar(options.progress, 1000, "sampling");
@@ -297,14 +298,26 @@ fn render_in_pool(
             irradiance::light_samples(&prep, &mut sets, &lighting, &b);
             b.finish_and_clear();
             timings.irradiance = t.elapsed();
-            sets
+            Cow::Owned(sets)
         }
     };
+    let sample_count: usize = sets.iter().map(|s| s.len()).sum();
+    let (area, count) = sets
+        .iter()
+        .flat_map(|s| &s.areas)
+        .fold((0.0, 0usize), |(a, n), &x| (a + f64::from(x), n + 1));
 
     // Caches, and K tables for the split methods.
     let t = Instant::now();
     let method = core_method(settings.method);
-    let built = irradiance::build_caches(&sets)?;
+    let built = match sets {
+        Cow::Borrowed(baked) => baked
+            .iter()
+            .map(|s| s.object)
+            .zip(irradiance::build_caches(baked)?)
+            .collect(),
+        Cow::Owned(sets) => irradiance::build_caches_releasing(sets)?,
+    };
     let mut caches: Vec<Option<ObjectCache>> = (0..scene.objects.len()).map(|_| None).collect();
     let mut cache_bytes = 0;
     let local_term = |object: usize, alpha: f32| match prep.shader_of(object) {
@@ -321,15 +334,15 @@ fn render_in_pool(
         Shader::Translucent(shader) => Some(&**shader),
         _ => None,
     };
-    for (set, cache) in sets.iter().zip(built) {
+    for (object, cache) in built {
         let alpha = cache.smoothing_radius(settings.smoothing);
-        let local = local_term(set.object, alpha)?;
+        let local = local_term(object, alpha)?;
         cache_bytes += cache.memory_bytes();
-        caches[set.object] = Some(ObjectCache::new(
+        caches[object] = Some(ObjectCache::new(
             cache,
             alpha,
             local,
-            translucent_shader(set.object),
+            translucent_shader(object),
         )?);
     }
     // A translucent object far smaller than the sample spacing can receive no sample at all.
@@ -337,10 +350,6 @@ fn render_in_pool(
     // shade it with their local term alone, E(x)·K (the Lambertian limit when α ≫ ℓ), the
     // unsplit ones with no subsurface light. (Without this, shading it failed with "internal
     // error: no irradiance cache".)
-    let (area, count) = sets
-        .iter()
-        .flat_map(|s| &s.areas)
-        .fold((0.0, 0usize), |(a, n), &x| (a + f64::from(x), n + 1));
     let spacing_area = if count > 0 {
         (area / count as f64) as f32
     } else {
@@ -440,7 +449,7 @@ fn render_in_pool(
         image,
         pixels,
         stats: RenderStats {
-            samples: sets.iter().map(|s| s.len()).sum(),
+            samples: sample_count,
             density: plan,
             warning,
             cache_bytes,
