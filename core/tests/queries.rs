@@ -521,7 +521,8 @@ fn jittered_plane(n: usize, h: f32, e: f32, seed: u64) -> Vec<lucent_core::Sampl
     samples
 }
 
-/// N10's local irradiance against its formula in double precision (reference sheet §6a):
+/// N10's local irradiance against its formula in double precision (the talk's Rd(0)-weighted
+/// query, as `core/src/query.rs` states it):
 /// E_loc = [Rd(0) Ā E(x) + Σ w Rd A E] / [Rd(0) Ā + Σ w Rd A], within `tolerance` (relative),
 /// and the whole edge-aware result against `exhaustive_edge_aware`.
 fn assert_edge_aware_matches_f64(
@@ -622,6 +623,17 @@ fn edge_aware_local_irradiance_survives_huge_irradiance_in_a_wide_kernel() {
     assert_edge_aware_matches_f64(&samples, &p, 15.0, &plane_points(40, h, 1e37, 34), 1e-4);
 }
 
+/// [`unlit_surface_failures`] finds none.
+fn assert_unlit_surface_weighed(spread: f32, trials: usize, seed: u64) {
+    let failures = unlit_surface_failures(spread, trials, seed);
+    assert!(
+        failures.is_empty(),
+        "{} failures: {:?}",
+        failures.len(),
+        &failures[..failures.len().min(4)]
+    );
+}
+
 /// Queries N10 at each of eight unlit samples spread over `spread` (x on their leaf's sphere),
 /// with one lit sample far away; returns the queries whose E_loc misses x's own weight.
 fn unlit_surface_failures(spread: f32, trials: usize, seed: u64) -> Vec<(usize, Vec3, Vec3)> {
@@ -682,13 +694,7 @@ fn unlit_surface_failures(spread: f32, trials: usize, seed: u64) -> Vec<(usize, 
 /// (5 of these 8000 queries, E_loc 1 instead of 1/2).
 #[test]
 fn edge_aware_weighs_unlit_samples_on_the_surface_of_a_huge_node() {
-    let failures = unlit_surface_failures(1e9, 1000, 41);
-    assert!(
-        failures.is_empty(),
-        "{} failures: {:?}",
-        failures.len(),
-        &failures[..failures.len().min(4)]
-    );
+    assert_unlit_surface_weighed(1e9, 1000, 41);
 }
 
 /// The same where the distance to the centroid squares past f32::MAX (spread 10²⁰): the
@@ -696,13 +702,7 @@ fn edge_aware_weighs_unlit_samples_on_the_surface_of_a_huge_node() {
 /// fuzzing, `crash-centroid-distance-squared-overflows`).
 #[test]
 fn edge_aware_weighs_unlit_samples_of_a_node_beyond_f32_squares() {
-    let failures = unlit_surface_failures(1e20, 50, 42);
-    assert!(
-        failures.is_empty(),
-        "{} failures: {:?}",
-        failures.len(),
-        &failures[..failures.len().min(4)]
-    );
+    assert_unlit_surface_weighed(1e20, 50, 42);
 }
 
 /// The same near ±f32::MAX (spread 3.2·10³⁸): the offsets to the centroids overflow too, and
@@ -710,11 +710,5 @@ fn edge_aware_weighs_unlit_samples_of_a_node_beyond_f32_squares() {
 /// fuzzing, `crash-unbounded-root-near-f32-max`).
 #[test]
 fn edge_aware_weighs_unlit_samples_near_f32_max() {
-    let failures = unlit_surface_failures(3.2e38, 50, 43);
-    assert!(
-        failures.is_empty(),
-        "{} failures: {:?}",
-        failures.len(),
-        &failures[..failures.len().min(4)]
-    );
+    assert_unlit_surface_weighed(3.2e38, 50, 43);
 }

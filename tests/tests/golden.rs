@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use lucent_core::glam::Vec3;
 use lucent_raster::output::image::LAYER_EXITANCE;
 use lucent_raster::output::png::write_png_rgb8;
-use lucent_raster::output::{LayerData, read_exr, read_png, write_exr, write_png};
+use lucent_raster::output::{LayerData, RgbImage, read_exr, read_png, write_exr, write_png};
 use lucent_raster::render::{Prepared, RenderOptions, bake, rasterize, render, write_baked};
 use lucent_raster::scene::{ExrLayers, SampleDensity, Scene, default_scene, load_scene};
 
@@ -109,6 +109,43 @@ fn compare_rgb(what: &str, got: &[Vec3], want: &[Vec3], exact: bool) {
     }
 }
 
+/// `image` encoded as the renderer writes it (8-bit sRGB at `exposure` stops) equals the PNG at
+/// `want`: byte for byte on the pinned build, within one code per channel elsewhere. Regenerate
+/// with `LUCENT_BLESS=1 cargo test -p lucent-tests --test golden`.
+fn assert_png_matches(what: &str, image: &RgbImage, exposure: f32, want: &Path) {
+    let actual = std::env::temp_dir().join(format!(
+        "lucent-{what}-{}-{}",
+        std::process::id(),
+        want.file_name().unwrap().to_string_lossy()
+    ));
+    write_png(&actual, image, exposure).unwrap();
+    if PINNED {
+        let (got, expected) = (
+            std::fs::read(&actual).unwrap(),
+            std::fs::read(want).unwrap(),
+        );
+        assert!(
+            got == expected,
+            "{what}: PNG bytes differ from {} (actual: {}); regenerate with LUCENT_BLESS=1 cargo \
+             test -p lucent-tests --test golden",
+            want.display(),
+            actual.display()
+        );
+    } else {
+        let expected = read_png(want).unwrap();
+        let enc = |v: f32| lucent_raster::output::srgb::Srgb8Encoder::new(0.0).encode(v) as i32;
+        for (g, w) in image.pixels().iter().zip(expected.pixels()) {
+            let g = *g * 2f32.powf(exposure);
+            assert!(
+                (0..3).all(|c| (enc(g[c]) - enc(w[c])).abs() <= 1),
+                "{what}: 8-bit pixel of {} off by more than one code",
+                want.display()
+            );
+        }
+    }
+    let _ = std::fs::remove_file(&actual);
+}
+
 #[test]
 fn renders_match_their_goldens() {
     for (name, scene) in scenes() {
@@ -153,28 +190,10 @@ fn renders_match_their_goldens() {
         let _ = std::fs::remove_file(&actual);
 
         // The 8-bit image: exact when pinned; elsewhere within one code per channel.
-        let want_png = std::fs::read(&png).unwrap_or_else(|_| panic!("{}", missing(&png)));
-        let actual = std::env::temp_dir().join(format!("lucent-{name}-{}.png", std::process::id()));
-        write_png(&actual, &r.image, scene.render.exposure).unwrap();
-        let got_png = std::fs::read(&actual).unwrap();
-        if PINNED {
-            assert!(
-                got_png == want_png,
-                "{name}: PNG bytes differ from the golden (actual: {})",
-                actual.display()
-            );
-            let _ = std::fs::remove_file(&actual);
-        } else {
-            let want = read_png(&png).unwrap();
-            let enc = |v: f32| lucent_raster::output::srgb::Srgb8Encoder::new(0.0).encode(v) as i32;
-            for (g, w) in r.image.pixels().iter().zip(want.pixels()) {
-                let g = *g * 2f32.powf(scene.render.exposure);
-                assert!(
-                    (0..3).all(|c| (enc(g[c]) - enc(w[c])).abs() <= 1),
-                    "{name}: 8-bit pixel off by more than one code"
-                );
-            }
+        if !png.exists() {
+            panic!("{}", missing(&png));
         }
+        assert_png_matches(name, &r.image, scene.render.exposure, &png);
 
         // Floats: depth exactly, shading exactly when pinned.
         let want_exr = read_exr(&exr).unwrap_or_else(|_| panic!("{}", missing(&exr)));
@@ -343,32 +362,6 @@ fn readme_images_match_the_renderer() {
             eprintln!("rendered {}", path.display());
             continue;
         }
-        let actual =
-            std::env::temp_dir().join(format!("lucent-readme-{name}-{}.png", std::process::id()));
-        write_png(&actual, &r.image, scene.render.exposure).unwrap();
-        if PINNED {
-            let (got, want) = (
-                std::fs::read(&actual).unwrap(),
-                std::fs::read(&path).unwrap(),
-            );
-            assert!(
-                got == want,
-                "{} is not what the renderer makes (actual: {}); regenerate with LUCENT_BLESS=1 \
-                 cargo test -p lucent-tests --test golden",
-                path.display(),
-                actual.display()
-            );
-        } else {
-            let want = read_png(&path).unwrap();
-            let enc = |v: f32| lucent_raster::output::srgb::Srgb8Encoder::new(0.0).encode(v) as i32;
-            for (g, w) in r.image.pixels().iter().zip(want.pixels()) {
-                let g = *g * 2f32.powf(scene.render.exposure);
-                assert!(
-                    (0..3).all(|c| (enc(g[c]) - enc(w[c])).abs() <= 1),
-                    "{name}: README image off by more than one code"
-                );
-            }
-        }
-        let _ = std::fs::remove_file(&actual);
+        assert_png_matches(name, &r.image, scene.render.exposure, &path);
     }
 }

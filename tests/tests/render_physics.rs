@@ -256,7 +256,8 @@ fn statistics_time_the_translucent_points_without_changing_the_image() {
 /// The uniform-plane experiment for per-sample areas: a plane far larger than the diffusion
 /// length under a directional light, seen from straight above by a square camera over its
 /// middle (about 2 units across). A flat, uniformly lit surface has radiant exitance
-/// E · Rd_total (reference sheet §7), so every pixel should show exactly that.
+/// E · Rd_total (README, Conventions: radiance from exitance), so every pixel should show
+/// exactly that.
 mod uniform_plane {
     use lucent_core::glam::Vec3;
     use lucent_core::{Profile, presets};

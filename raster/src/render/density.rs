@@ -2,7 +2,7 @@
 //! default), the memory-sized cap on it, and the warning when the samples are too far apart
 //! for the material.
 //!
-//! The dipole profile falls off as e^(−σ_tr·r)/r² (JB02 eq. 4–5; reference sheet §2), so the
+//! The dipole profile (Jensen et al. 2001) falls off as e^(−σ_tr·r)/r², so the
 //! distance that matters is the **diffuse mean free path ℓ_d = 1/σ_tr**. One Poisson-disk set
 //! covers every translucent object, so the shared spacing must resolve the smallest ℓ_d of any
 //! channel of any translucent material (for a texture-mapped ℓ, the smallest the texture

@@ -6,7 +6,7 @@
 //! restricted Voronoi diagram ([`voronoi_areas`]): the areas of an object sum to its surface
 //! area, and a sample that stands closer to its neighbours weighs less, so the density
 //! fluctuations of the blue noise and the denser samples near a surface's border do not become
-//! exitance error as they did with equal areas (total / N, reference sheet §4). Cells are per
+//! exitance error as they did with equal areas (total / N, as in JB02). Cells are per
 //! object (a sample never takes area of another object), and so are the caches: light does not
 //! diffuse from one object into another.
 

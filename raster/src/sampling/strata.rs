@@ -232,13 +232,7 @@ mod tests {
     #[test]
     fn candidate_counts_per_region_are_nearly_exact() {
         // A 40 × 40 square of two triangles, 300k candidates: count per 4 × 4 box.
-        let q = [
-            Vec3::new(-20.0, -20.0, 0.0),
-            Vec3::new(20.0, -20.0, 0.0),
-            Vec3::new(20.0, 20.0, 0.0),
-            Vec3::new(-20.0, 20.0, 0.0),
-        ];
-        let tris = [[q[0], q[1], q[2]], [q[0], q[2], q[3]]];
+        let tris = crate::sampling::tests::square_40();
         let m = 300_000;
         let s = Strata::new(&tris, 1600.0, m);
         let mut rng = Pcg32::new(1, 1);

@@ -7,9 +7,10 @@ use super::rng::Pcg32;
 use super::*;
 use crate::geometry::shapes::{grid, icosphere};
 
-/// A unit sphere resting above a 6×6 floor: curved and flat surfaces, different triangle sizes.
-fn sphere_and_plane() -> Vec<[Vec3; 3]> {
-    let mut tris = icosphere(3, Vec3::new(0.0, 0.0, 1.2), 1.0);
+/// A unit sphere (icosphere of `subdivisions`) resting above a 6×6 floor: curved and flat
+/// surfaces, different triangle sizes.
+pub(super) fn sphere_over_floor(subdivisions: u32) -> Vec<[Vec3; 3]> {
+    let mut tris = icosphere(subdivisions, Vec3::new(0.0, 0.0, 1.2), 1.0);
     tris.extend(grid(
         Vec3::new(-3.0, -3.0, 0.0),
         Vec3::X * 6.0,
@@ -18,6 +19,21 @@ fn sphere_and_plane() -> Vec<[Vec3; 3]> {
         12,
     ));
     tris
+}
+
+fn sphere_and_plane() -> Vec<[Vec3; 3]> {
+    sphere_over_floor(3)
+}
+
+/// The 40 × 40 square about the origin in the plane z = 0, as two triangles.
+pub(super) fn square_40() -> [[Vec3; 3]; 2] {
+    let q = [
+        Vec3::new(-20.0, -20.0, 0.0),
+        Vec3::new(20.0, -20.0, 0.0),
+        Vec3::new(20.0, 20.0, 0.0),
+        Vec3::new(-20.0, 20.0, 0.0),
+    ];
+    [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
 }
 
 /// Smallest pairwise 3-D distance, by brute force (in f64, so huge scenes do not overflow).
@@ -328,18 +344,7 @@ fn hundred_thousand_samples_in_well_under_a_second() {
 /// 1.21% with plain elimination, 4.1% for uniform random points.
 #[test]
 fn patch_counts_are_nearly_exact() {
-    let q = [
-        Vec3::new(-20.0, -20.0, 0.0),
-        Vec3::new(20.0, -20.0, 0.0),
-        Vec3::new(20.0, 20.0, 0.0),
-        Vec3::new(-20.0, 20.0, 0.0),
-    ];
-    let s = poisson_samples(
-        &[[q[0], q[1], q[2]], [q[0], q[2], q[3]]],
-        SampleTarget::Count(60_000),
-        1,
-    )
-    .unwrap();
+    let s = poisson_samples(&square_40(), SampleTarget::Count(60_000), 1).unwrap();
     let mut counts = vec![0f64; 100];
     for p in &s {
         let (x, y) = (
@@ -361,13 +366,7 @@ fn patch_counts_are_nearly_exact() {
 /// The quality figures of the 40 × 40 plane with 60k samples: minimum distance relative to
 /// the hexagonal spacing, and the std of the counts in 4 × 4 and 8 × 8 boxes.
 fn plane_figures(seed: u64) -> (f32, f64, f64) {
-    let q = [
-        Vec3::new(-20.0, -20.0, 0.0),
-        Vec3::new(20.0, -20.0, 0.0),
-        Vec3::new(20.0, 20.0, 0.0),
-        Vec3::new(-20.0, 20.0, 0.0),
-    ];
-    let tris = [[q[0], q[1], q[2]], [q[0], q[2], q[3]]];
+    let tris = square_40();
     let n = 60_000;
     let s = poisson_samples(&tris, SampleTarget::Count(n), seed).unwrap();
     let box_std = |size: f32| {

@@ -10,15 +10,7 @@ use crate::sampling::{SampleTarget, poisson_samples, total_area};
 
 /// A sphere above a floor (curved and flat, different triangle sizes).
 fn sphere_and_plane() -> Vec<[Vec3; 3]> {
-    let mut tris = icosphere(2, Vec3::new(0.0, 0.0, 1.2), 1.0);
-    tris.extend(grid(
-        Vec3::new(-3.0, -3.0, 0.0),
-        Vec3::X * 6.0,
-        Vec3::Y * 6.0,
-        12,
-        12,
-    ));
-    tris
+    crate::sampling::tests::sphere_over_floor(2)
 }
 
 fn poisson(tris: &[[Vec3; 3]], n: u32, seed: u64) -> Vec<Vec3> {
