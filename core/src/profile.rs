@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::dipole::{self, Dipole};
+use crate::dipole::{self, Dipole, NodeMoments};
 use crate::error::ParamError;
 use crate::fresnel;
 use crate::lanes::Lanes;
@@ -216,14 +216,14 @@ impl Profile {
             self.channels[2].rd_lanes(r2),
         ]
     }
-    /// Second-order corrected node aggregate per channel (see
+    /// Fourth-order corrected node aggregate per channel (see
     /// [`Dipole::rd_lanes_corrected`]).
     #[inline(always)]
-    pub fn rd_lanes_corrected<L: Lanes>(&self, r2: L, q: L, trace: L) -> [L; 3] {
+    pub fn rd_lanes_corrected<L: Lanes>(&self, r2: L, m: &NodeMoments<L>) -> [L; 3] {
         [
-            self.channels[0].rd_lanes_corrected(r2, q, trace),
-            self.channels[1].rd_lanes_corrected(r2, q, trace),
-            self.channels[2].rd_lanes_corrected(r2, q, trace),
+            self.channels[0].rd_lanes_corrected(r2, m),
+            self.channels[1].rd_lanes_corrected(r2, m),
+            self.channels[2].rd_lanes_corrected(r2, m),
         ]
     }
     /// Rd(0) per channel.

@@ -22,7 +22,7 @@
 //!                                 (area-weighted where the node has no flux)
 //!   radius                        max |p_i − P|: the node's bounding sphere about P
 //!   cov_xx cov_yy cov_zz          C = Σ w_i (p_i − P)(p_i − P)ᵀ / Σ w_i, the same weights:
-//!   cov_xy cov_xz cov_yz          for the second-order aggregate (see `traverse.rs`)
+//!   cov_xy cov_xz cov_yz          for the fourth-order aggregate (see `traverse.rs`)
 //!   first: u32                    first child (internal) or first sample (leaf)
 //!   info:  u32                    bit 31 = leaf; bits 0..4 = count (1..=8)
 //! ```

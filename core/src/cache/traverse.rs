@@ -15,11 +15,15 @@
 //!    sphere, all of it on the dark side;
 //! 3. **aggregate** (JB02): x outside the bounds, the bounds clear of the α-ball (split modes,
 //!    LM07's refinement rule), and ΔΩ = A/|x − P|² < ε → one term: the flux times the mean of
-//!    Rd over the node *to second order*, from its covariance (departure from JB02, which
-//!    takes Rd at the centroid alone and underestimates where Rd is convex; see
-//!    [`crate::Dipole::rd_lanes_corrected`]). Measured on a 23k-sample sphere against the
-//!    exhaustive sum, the error falls 5–30× at equal ε, and the 0.6% image error that plain
-//!    aggregates reach at ε ≈ 0.4 is reached at ε ≈ 2 with about a quarter of the evaluations;
+//!    Rd over the node *to fourth order* in the Taylor expansion about the centroid, from its
+//!    covariance (departure from JB02, which takes Rd at the centroid alone and underestimates
+//!    where Rd is convex; see [`crate::Dipole::rd_lanes_corrected`] for the derivation). The
+//!    second-order term alone cut the error against the exhaustive sum 5–30× at equal ε on a
+//!    23k-sample sphere (the 0.6% image error that plain aggregates reach at ε ≈ 0.4 was
+//!    reached at ε ≈ 2 with about a quarter of the evaluations), but left a negative bias of
+//!    the order of ε², −0.3% on a uniformly lit plane at the default ε = 0.5; the fourth-order
+//!    term, from the covariance under a uniform-disc closure of the fourth moment (no new node
+//!    data), brings it to −0.02…−0.07%;
 //! 4. **cull**: of the rest, a child is skipped (never one touching the α-ball) when, in every
 //!    channel, its contribution bound Rd(dmin)·flux (Rd is decreasing) is at most
 //!    `tolerance × (sum so far) × A_child / A_total`. Culled subtrees are disjoint and the
@@ -53,6 +57,15 @@
 //! - only N10 folds its local sums; the two evaluation functions are out of line, so that the
 //!   profile no longer crowds the node loop's registers.
 //!
+//! The fourth-order term costs about a fifth more instructions per lookup (callgrind, the
+//! sphere of `examples/profile_query.rs` at ε 0.5: hierarchical 19 700 → 23 800, edge-aware
+//! 21 400 → 25 300; the nodes visited are the same): four more moment columns per aggregate,
+//! formed on the node's eight lanes, and seven more operations per source and channel. The
+//! first version, with θ₄ and θ₅ written out, cost 3 points more; folding them into the
+//! coefficients of θ₃ and θ₂ as polynomials in ρ = r²/d², with coefficients shared by both
+//! sources, cut that. At equal bias it is cheaper: ε 1 with the fourth-order term has about
+//! the plane bias of the second-order term at ε 0.5, for 13 500 instructions instead of 19 700.
+//!
 //! Tried and dropped (no gain measured): one division instead of two per source in the
 //! corrected profile (a longer dependency chain; the divider was not the bottleneck); an exp
 //! taking the positive argument (the compiler had already folded the negation); merging the
@@ -68,6 +81,7 @@
 use glam::{DVec3, Vec3};
 
 use super::{COUNT_MASK, IrradianceCache, LEAF_BIT, MAX_DEPTH};
+use crate::dipole::NodeMoments;
 use crate::kernel::Kernel;
 use crate::lanes::{LANES, Lanes, Mask};
 use crate::profile::Profile;
@@ -223,8 +237,9 @@ struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     x: [L; 3],
     /// Sample terms: r², flux r g b, area.
     samples: Buffer<5>,
-    /// Aggregate terms: r², flux r g b, vᵀCv/r², tr C.
-    aggregates: Buffer<6>,
+    /// Aggregate terms: r², flux r g b, then the node's moments (see [`NodeMoments`]):
+    /// vᵀCv/r², tr C, |Cv|²/r², tr C².
+    aggregates: Buffer<8>,
     global: [L; 3],
     local_flux: [L; 3],
     local_weight: [L; 3],
@@ -325,9 +340,15 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
     #[inline(never)]
     fn evaluate_aggregates(&mut self, n: usize) {
         self.count_batch();
-        let [r2, fr, fg, fb, q, trace] = self.aggregates.batch::<L>();
+        let [r2, fr, fg, fb, q, trace, cross, trace_sq] = self.aggregates.batch::<L>();
         let valid = Mask::first(n as u32);
-        let rd = self.profile.rd_lanes_corrected(r2, q, trace);
+        let moments = NodeMoments {
+            q,
+            trace,
+            cross,
+            trace_sq,
+        };
+        let rd = self.profile.rd_lanes_corrected(r2, &moments);
         for (c, f) in [fr, fg, fb].into_iter().enumerate() {
             self.global[c] = self.global[c] + rd[c] * f.keep(valid);
         }
@@ -481,7 +502,8 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
             let aggregate = live & outside & !near & small;
             if aggregate.any() {
                 self.stats.aggregates(aggregate.0.count_ones());
-                // vᵀCv and tr C for the second-order aggregate (v = P − x).
+                // The moments of the fourth-order aggregate (v = P − x): vᵀCv, |Cv|², tr C
+                // and tr C².
                 let (sxx, syy, szz) = (
                     load(&nodes.cov_xx),
                     load(&nodes.cov_yy),
@@ -492,18 +514,26 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                     load(&nodes.cov_xz),
                     load(&nodes.cov_yz),
                 );
-                let vcv = sxx * cx * cx
-                    + syy * cy * cy
-                    + szz * cz * cz
-                    + L::splat(2.0) * (sxy * cx * cy + sxz * cx * cz + syz * cy * cz);
-                // Aggregated lanes are outside their sphere, so dist2 > 0 there; q ≤ λ_max ≤ tr C
-                // mathematically, and the clamp keeps overflowed lanes (∞/∞) finite.
+                let cvx = sxx * cx + sxy * cy + sxz * cz;
+                let cvy = sxy * cx + syy * cy + syz * cz;
+                let cvz = sxz * cx + syz * cy + szz * cz;
+                let vcv = cx * cvx + cy * cvy + cz * cvz;
+                let cv2 = cvx * cvx + cvy * cvy + cvz * cvz;
                 let trace = sxx + syy + szz;
-                let q = (vcv / dist2).min(trace).max(zero);
-                if self
-                    .aggregates
-                    .append(aggregate, [dist2, flux[0], flux[1], flux[2], q, trace])
-                {
+                let trace_sq = sxx * sxx
+                    + syy * syy
+                    + szz * szz
+                    + L::splat(2.0) * (sxy * sxy + sxz * sxz + syz * syz);
+                // Aggregated lanes are outside their sphere, so dist2 > 0 there. Mathematically
+                // q ≤ λ_max ≤ tr C and q² ≤ p = vᵀC²v/r² ≤ λ_max q; the clamps keep rounding
+                // within those bounds and overflowed lanes (∞/∞) finite.
+                let inv_dist2 = L::splat(1.0) / dist2;
+                let q = (vcv * inv_dist2).min(trace).max(zero);
+                let cross = (cv2 * inv_dist2).min(trace * q).max(q * q);
+                if self.aggregates.append(
+                    aggregate,
+                    [dist2, flux[0], flux[1], flux[2], q, trace, cross, trace_sq],
+                ) {
                     self.evaluate_aggregates(LANES);
                     self.aggregates.consume();
                 }
