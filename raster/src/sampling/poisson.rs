@@ -44,7 +44,7 @@
 //! be regenerated at will, by any thread. A first pass counts the candidates per tile, a
 //! second writes each one's position and index straight to its slot (a counting sort), and
 //! after the elimination a third regenerates the blocks and keeps the survivors. What is held
-//! per candidate is its slot (position and index, 16 B), its weight (4 B) and a removal bit;
+//! per candidate is its slot (position and weight, 16 B; a removal sets the weight to −∞) and its index (4 B);
 //! per sample (five candidates) about 105 B, then 24 B for the output. The tiles' cell lists
 //! and neighbour tables are a few bytes per sample.
 //!
@@ -61,13 +61,11 @@
 //! samples); recomputing the weights at every round instead of writing back the halo's cost
 //! 25% more time.
 
-use std::sync::atomic::{AtomicU32, Ordering};
-
 use glam::Vec3;
 use rayon::prelude::*;
 
 use super::error::SamplingError;
-use super::grid::{Bits, ChunkCounts, Layout, Neighbourhood, Tiles, count_tiles};
+use super::grid::{ChunkCounts, Layout, Neighbourhood, Tiles, count_tiles};
 use super::maxtree::MaxTree;
 use super::rng::{Pcg32, splitmix64};
 use super::strata::Strata;
@@ -173,17 +171,15 @@ pub fn poisson_samples_with_progress(
     for t in 0..tiles.len() {
         by_colour[tiles.colour(t)].push(t as u32);
     }
-    let removed = Bits::new(m);
     let kernel = Kernel::new(d_min / d_max);
     // Every candidate's weight, summed once over its neighbours (any order: nothing changes
     // yet), then kept up to date by the removals. Each slot is written by one task only: its
     // own tile's, or that of the one tile of the phase whose halo holds it (tiles of a colour
     // are a tile apart, and halos one cell deep).
-    let weights: Vec<AtomicU32> = (0..m).map(|_| AtomicU32::new(0)).collect();
     (0..tiles.len())
         .into_par_iter()
         .for_each_init(Scratch::default, |scratch, t| {
-            sum_weights(&tiles, t, d_max, &kernel, &weights, scratch)
+            sum_weights(&tiles, t, d_max, &kernel, scratch)
         });
     for (round, &left) in SCHEDULE.iter().enumerate() {
         for c in 0..8 {
@@ -195,11 +191,7 @@ pub fn poisson_samples_with_progress(
                     let count = tiles.slot_range(t).len();
                     let q = quota[t] as usize;
                     let keep = q + ((count - q) as f64 * left) as usize;
-                    let state = State {
-                        removed: &removed,
-                        weights: &weights,
-                    };
-                    eliminate(&tiles, t, keep, d_max, &kernel, state, scratch);
+                    eliminate(&tiles, t, keep, d_max, &kernel, scratch);
                 });
             advance();
         }
@@ -207,14 +199,12 @@ pub fn poisson_samples_with_progress(
 
     // 4. The survivors, regenerated from their streams.
     let mut keep = vec![0u64; blocks * BLOCK / 64];
-    for (s, slot) in tiles.slots.iter().enumerate() {
-        if !removed.get(s as u32) {
-            keep[slot.index as usize / 64] |= 1 << (slot.index % 64);
+    for (slot, &i) in tiles.slots.iter().zip(&tiles.index) {
+        if !slot.removed() {
+            keep[i as usize / 64] |= 1 << (i % 64);
         }
     }
     drop(tiles);
-    drop(removed);
-    drop(weights);
     let per_block: Vec<usize> = keep
         .chunks(BLOCK / 64)
         .map(|w| w.iter().map(|x| x.count_ones() as usize).sum())
@@ -261,25 +251,10 @@ struct Scratch {
     sign: Vec<f32>,
 }
 
-/// The shared state of the elimination: which slots are removed, and every slot's weight
-/// (`f32` bits).
-#[derive(Clone, Copy)]
-struct State<'a> {
-    removed: &'a Bits,
-    weights: &'a [AtomicU32],
-}
-
-/// Sums the weights of tile `t`'s candidates over their neighbourhoods, into `weights`.
-fn sum_weights(
-    tiles: &Tiles,
-    t: usize,
-    d_max: f32,
-    kernel: &Kernel,
-    weights: &[AtomicU32],
-    scratch: &mut Scratch,
-) {
+/// Sums the weights of tile `t`'s candidates over their neighbourhoods, into their slots.
+fn sum_weights(tiles: &Tiles, t: usize, d_max: f32, kernel: &Kernel, scratch: &mut Scratch) {
     let near = &mut scratch.near;
-    tiles.gather(t, d_max, |_| false, near);
+    tiles.gather(t, d_max, near);
     let mut runs = [(0u32, 0u32); 9];
     for i in 0..near.len() {
         if near.own[i] {
@@ -289,7 +264,7 @@ fn sum_weights(
                 .iter()
                 .map(|&(a, b)| kernel.sum(p, near, a as usize..b as usize))
                 .sum();
-            weights[near.slot[i] as usize].store(w.to_bits(), Ordering::Relaxed);
+            tiles.slots[near.slot[i] as usize].set_weight(w);
         }
     }
 }
@@ -306,11 +281,10 @@ fn eliminate(
     keep: usize,
     d_max: f32,
     kernel: &Kernel,
-    state: State,
     scratch: &mut Scratch,
 ) {
     let near = &mut scratch.near;
-    tiles.gather(t, d_max, |s| state.removed.get(s), near);
+    tiles.gather(t, d_max, near);
     let mut alive = near.own.iter().filter(|&&o| o).count();
     if alive <= keep {
         return;
@@ -318,9 +292,8 @@ fn eliminate(
     let (w, sign) = (&mut scratch.weights, &mut scratch.sign);
     w.clear();
     sign.clear();
-    for i in 0..near.len() {
-        let s = if near.own[i] { 1.0 } else { -1.0 };
-        let x = f32::from_bits(state.weights[near.slot[i] as usize].load(Ordering::Relaxed));
+    for (&own, &x) in near.own.iter().zip(&near.w) {
+        let s = if own { 1.0 } else { -1.0 };
         w.push(s * x);
         sign.push(s);
     }
@@ -331,7 +304,6 @@ fn eliminate(
         let i = i as usize;
         debug_assert!(near.own[i] && w[i] > 0.0);
         w[i] = f32::NEG_INFINITY;
-        state.removed.set(near.slot[i]);
         alive -= 1;
         near.runs_near(near.cell[i], &mut runs);
         let p = [near.x[i], near.y[i], near.z[i]];
@@ -341,11 +313,9 @@ fn eliminate(
         }
         tree.update_ranges(w, |&x| x, &runs);
     }
-    for i in 0..near.len() {
-        if w[i] != f32::NEG_INFINITY {
-            let x = sign[i] * w[i];
-            state.weights[near.slot[i] as usize].store(x.to_bits(), Ordering::Relaxed);
-        }
+    // The removed (own) candidates are written back as −∞: removed.
+    for ((&slot, &s), &x) in near.slot.iter().zip(sign.iter()).zip(w.iter()) {
+        tiles.slots[slot as usize].set_weight(s * x);
     }
 }
 
