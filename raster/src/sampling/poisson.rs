@@ -44,9 +44,10 @@
 //! be regenerated at will, by any thread. A first pass counts the candidates per tile, a
 //! second writes each one's position and index straight to its slot (a counting sort), and
 //! after the elimination a third regenerates the blocks and keeps the survivors. What is held
-//! per candidate is its slot (position and weight, 16 B; a removal sets the weight to −∞) and its index (4 B);
-//! per sample (five candidates) about 105 B, then 24 B for the output. The tiles' cell lists
-//! and neighbour tables are a few bytes per sample.
+//! per candidate is its slot (position and weight, 16 B; a removal sets the weight to −∞) and
+//! its index (4 B): per sample (five candidates) about 105 B, then 24 B for the output, the
+//! peak of a whole render (the cache build holds less). The tiles' cell lists and neighbour
+//! tables are a few bytes per sample.
 //!
 //! **Cost.** Each weight is summed once (9 contiguous runs of the 27 cells around it, ~130
 //! candidates, vectorised), each removal updates the same runs and a small per-tile max-tree
