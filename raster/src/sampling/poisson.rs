@@ -54,8 +54,11 @@
 //! (`maxtree.rs`), and every round gathers each tile with its halo again; all of it in a few
 //! KB of local memory, so the elimination is bound by arithmetic instead of the memory latency
 //! of the former sequential elimination over the whole set (22 s for 1M samples, one thread).
-//! About 5.5 s of CPU for 1M samples on this machine, spread over the cores by the phases; the
-//! three generation passes are ~15% of it.
+//! About 6.8 s of CPU for 1M samples on the sphere with two threads on this machine, spread
+//! over the cores by the phases (`examples/placement_cost.rs`; figures in `BENCHMARKS.md`).
+//! By perf, the largest parts are the gathers (about a quarter: memory latency on the halo's
+//! slots, which is why a slot holds its weight and removal), the max-tree updates, the
+//! weight sums and removals, and the three generation passes (~15%).
 //!
 //! Alternatives considered: dart throwing cannot hit an exact count; keeping each candidate's
 //! neighbour list instead of re-scanning cells costs ~18 entries per candidate (~360 MB at 1M
