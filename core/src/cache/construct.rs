@@ -1,13 +1,22 @@
 //! Building the cache: validate, quantise, sort by Morton code, split into a breadth-first
-//! octree top-down by code prefixes, then aggregate bottom-up.
+//! octree top-down by code prefixes, then aggregate each node over its own (contiguous) run of
+//! samples.
 //!
 //! Cost: O(N log N) for the sort; each node's split costs eight binary searches over its
-//! range, so the split is O(N log N) too. Deterministic: the sort key (code, input index) is
-//! unique, and every sum is taken in a fixed order.
+//! range, so the split is O(N log N) too, and so is the aggregation (each sample is read twice
+//! per ancestor). Deterministic: the sort key (code, input index) is unique, and every sum is
+//! taken in a fixed order.
+//!
+//! Memory: besides the input and the cache itself, the build holds the sort keys (16 bytes per
+//! sample, freed once the columns are gathered), the sorted codes (8, freed after the split)
+//! and the split's node records (24 per node); every node's sums are local to its own
+//! aggregation, so nothing else grows with N.
 
 use alloc::vec::Vec;
 
-use glam::{DMat3, DVec3, Vec3};
+use core::ops::Range;
+
+use glam::{DVec3, Vec3};
 
 use super::{
     COUNT_MASK, IrradianceCache, LEAF_BIT, LEAF_CAPACITY, MAX_SAMPLES, Nodes, Sample, Samples,
@@ -180,6 +189,7 @@ impl IrradianceCache {
             };
             i += 1;
         }
+        drop(codes);
 
         let depth = pending.iter().map(|p| p.depth as usize).max().unwrap_or(0);
         let (nodes, bounds) = aggregate(&pending, &samples);
@@ -259,8 +269,8 @@ fn gather_samples(input: &[Sample], keys: &[(u64, u32)]) -> Samples {
     }
 }
 
-/// Per-node sums in double precision while aggregating.
-#[derive(Clone, Copy, Default)]
+/// One node's sums over its samples, in double precision.
+#[derive(Clone, Copy)]
 struct Sums {
     lo: DVec3,
     hi: DVec3,
@@ -276,24 +286,44 @@ struct Sums {
     count: f64,
 }
 
+/// Sample `j`'s position and flux in double precision.
+#[inline]
+fn sample_at(s: &Samples, j: usize) -> (DVec3, DVec3) {
+    (
+        DVec3::new(s.pos_x[j] as f64, s.pos_y[j] as f64, s.pos_z[j] as f64),
+        DVec3::new(s.flux_r[j] as f64, s.flux_g[j] as f64, s.flux_b[j] as f64),
+    )
+}
+
 impl Sums {
-    fn empty() -> Sums {
-        Sums {
+    /// The sums over the samples `range` (in order: the same input gives the same bits).
+    fn over(s: &Samples, range: Range<usize>) -> Sums {
+        let mut acc = Sums {
             lo: DVec3::INFINITY,
             hi: DVec3::NEG_INFINITY,
-            ..Default::default()
+            area: 0.0,
+            flux: DVec3::ZERO,
+            weighted: DVec3::ZERO,
+            weight: 0.0,
+            area_weighted: DVec3::ZERO,
+            position_sum: DVec3::ZERO,
+            count: 0.0,
+        };
+        for j in range {
+            let (pos, flux) = sample_at(s, j);
+            let area = s.area[j] as f64;
+            let w = flux.x + flux.y + flux.z;
+            acc.lo = acc.lo.min(pos);
+            acc.hi = acc.hi.max(pos);
+            acc.area += area;
+            acc.flux += flux;
+            acc.weighted += pos * w;
+            acc.weight += w;
+            acc.area_weighted += pos * area;
+            acc.position_sum += pos;
+            acc.count += 1.0;
         }
-    }
-    fn add(&mut self, o: &Sums) {
-        self.lo = self.lo.min(o.lo);
-        self.hi = self.hi.max(o.hi);
-        self.area += o.area;
-        self.flux += o.flux;
-        self.weighted += o.weighted;
-        self.weight += o.weight;
-        self.area_weighted += o.area_weighted;
-        self.position_sum += o.position_sum;
-        self.count += o.count;
+        acc
     }
     /// The weight of one sample under this node's weighting (flux, else area, else uniform).
     fn sample_weight(&self, flux: DVec3, area: f64) -> f64 {
@@ -305,19 +335,15 @@ impl Sums {
             1.0
         }
     }
-    /// The total weight of a child under this node's weighting.
-    fn child_weight(&self, child: &Sums) -> f64 {
-        if self.weight > 0.0 {
-            child.weight
-        } else if self.area > 0.0 {
-            child.area
-        } else {
-            child.count
-        }
-    }
     /// This node's total weight under its own weighting.
     fn total_weight(&self) -> f64 {
-        self.child_weight(self)
+        if self.weight > 0.0 {
+            self.weight
+        } else if self.area > 0.0 {
+            self.area
+        } else {
+            self.count
+        }
     }
     fn centroid(&self) -> DVec3 {
         let c = if self.weight > 0.0 {
@@ -331,142 +357,331 @@ impl Sums {
     }
 }
 
-/// Aggregates bottom-up (children have larger indices than parents, so a reverse sweep sees
-/// every child before its parent) and writes the node columns.
-#[allow(clippy::type_complexity)]
-fn aggregate(pending: &[Pending], s: &Samples) -> (Nodes, Option<(Vec3, Vec3)>) {
-    let count = pending.len();
-    let mut sums = alloc::vec![Sums::empty(); count];
-    for i in (0..count).rev() {
-        let p = pending[i];
-        let mut acc = Sums::empty();
-        if p.leaf {
-            for j in p.first as usize..(p.first + p.count) as usize {
-                let pos = DVec3::new(s.pos_x[j] as f64, s.pos_y[j] as f64, s.pos_z[j] as f64);
-                let flux = DVec3::new(s.flux_r[j] as f64, s.flux_g[j] as f64, s.flux_b[j] as f64);
-                let area = s.area[j] as f64;
-                let w = flux.x + flux.y + flux.z;
-                acc.add(&Sums {
-                    lo: pos,
-                    hi: pos,
-                    area,
-                    flux,
-                    weighted: pos * w,
-                    weight: w,
-                    area_weighted: pos * area,
-                    position_sum: pos,
-                    count: 1.0,
-                });
-            }
-        } else {
-            for c in p.first as usize..(p.first + p.count) as usize {
-                acc.add(&sums[c]);
-            }
+/// A node's weighted covariance about its centroid (the centroid's weights), in the order
+/// `[xx, yy, zz, xy, xz, yz]`, and the radius of the sphere about its centroid as stored (f32)
+/// that holds all its samples, exact and rounded up. Two-pass (the centroid first), so no
+/// cancellation; a covariance that does not fit f32 (coordinates beyond ~1e19) is zero, and
+/// the node's aggregate falls back to JB02's plain one.
+fn spread(s: &Samples, range: Range<usize>, sums: &Sums, centre: DVec3) -> ([f32; 6], f32) {
+    let stored = centre.as_vec3().as_dvec3();
+    let mut acc = [0.0f64; 6];
+    let mut r2 = 0.0f64;
+    for j in range {
+        let (pos, flux) = sample_at(s, j);
+        let w = sums.sample_weight(flux, s.area[j] as f64);
+        let d = pos - centre;
+        for (a, v) in acc.iter_mut().zip([
+            d.x * d.x,
+            d.y * d.y,
+            d.z * d.z,
+            d.y * d.x,
+            d.z * d.x,
+            d.z * d.y,
+        ]) {
+            *a += v * w;
         }
-        sums[i] = acc;
+        r2 = r2.max((pos - stored).length_squared());
     }
-
-    let centroids: Vec<DVec3> = sums.iter().map(Sums::centroid).collect();
-    let covariances = covariances(pending, s, &sums, &centroids);
-    let radii = radii(pending, s, &centroids);
-
-    let padded = count + LANES;
-    let column = |values: &mut dyn Iterator<Item = f32>| {
-        let mut c = Vec::with_capacity(padded);
-        c.extend(values);
-        c.resize(padded, 0.0);
-        c
-    };
-    let cov = |a: usize, b: usize| column(&mut covariances.iter().map(|m| m.col(a)[b] as f32));
-    let mut first = Vec::with_capacity(padded);
-    let mut info = Vec::with_capacity(padded);
-    for p in pending {
-        first.push(p.first);
-        info.push((p.count & COUNT_MASK) | if p.leaf { LEAF_BIT } else { 0 });
-    }
-    first.resize(padded, 0);
-    info.resize(padded, 0);
-    let root_bounds = sums.first().map(|r| (r.lo.as_vec3(), r.hi.as_vec3()));
-    let nodes = Nodes {
-        area: column(&mut sums.iter().map(|s| s.area as f32)),
-        flux_r: column(&mut sums.iter().map(|s| s.flux.x as f32)),
-        flux_g: column(&mut sums.iter().map(|s| s.flux.y as f32)),
-        flux_b: column(&mut sums.iter().map(|s| s.flux.z as f32)),
-        centroid_x: column(&mut centroids.iter().map(|c| c.x as f32)),
-        centroid_y: column(&mut centroids.iter().map(|c| c.y as f32)),
-        centroid_z: column(&mut centroids.iter().map(|c| c.z as f32)),
-        radius: column(&mut radii.into_iter()),
-        cov_xx: cov(0, 0),
-        cov_yy: cov(1, 1),
-        cov_zz: cov(2, 2),
-        cov_xy: cov(0, 1),
-        cov_xz: cov(0, 2),
-        cov_yz: cov(1, 2),
-        first,
-        info,
-    };
-    (nodes, root_bounds)
-}
-
-/// Per node, the weighted covariance of its samples about its centroid (the same weights as
-/// the centroid), bottom-up by the parallel-axis theorem:
-/// C = Σ_children W_c (C_c + (P_c − P)(P_c − P)ᵀ) / W.
-fn covariances(pending: &[Pending], s: &Samples, sums: &[Sums], centroids: &[DVec3]) -> Vec<DMat3> {
-    let outer = |d: DVec3| DMat3::from_cols(d * d.x, d * d.y, d * d.z);
-    let mut cov = alloc::vec![DMat3::ZERO; pending.len()];
-    for i in (0..pending.len()).rev() {
-        let p = pending[i];
-        let node = &sums[i];
-        let centre = centroids[i];
-        let mut acc = DMat3::ZERO;
-        if p.leaf {
-            for j in p.first as usize..(p.first + p.count) as usize {
-                let pos = DVec3::new(s.pos_x[j] as f64, s.pos_y[j] as f64, s.pos_z[j] as f64);
-                let flux = DVec3::new(s.flux_r[j] as f64, s.flux_g[j] as f64, s.flux_b[j] as f64);
-                acc += outer(pos - centre) * node.sample_weight(flux, s.area[j] as f64);
-            }
-        } else {
-            for c in p.first as usize..(p.first + p.count) as usize {
-                acc += (cov[c] + outer(centroids[c] - centre)) * node.child_weight(&sums[c]);
-            }
-        }
-        cov[i] = acc * (1.0 / node.total_weight().max(f64::MIN_POSITIVE));
-    }
-    // A node whose covariance does not fit f32 (coordinates beyond ~1e19) gets none: its
-    // aggregate falls back to JB02's plain one.
-    for c in &mut cov {
-        if !c
-            .to_cols_array()
-            .iter()
-            .all(|v| v.is_finite() && v.abs() <= f32::MAX as f64)
-        {
-            *c = DMat3::ZERO;
-        }
-    }
-    cov
-}
-
-/// Per node, the radius of the sphere about its centroid that holds all its samples, exact
-/// (every sample visited once per ancestor), measured about the centroid as stored (f32) and
-/// rounded up.
-fn radii(pending: &[Pending], s: &Samples, centroids: &[DVec3]) -> Vec<f32> {
-    pending
+    let scale = 1.0 / sums.total_weight().max(f64::MIN_POSITIVE);
+    let cov = acc.map(|a| a * scale);
+    let cov = if cov
         .iter()
-        .zip(centroids)
-        .map(|(p, &centre)| {
-            let centre = centre.as_vec3().as_dvec3();
-            let mut r2 = 0.0f64;
-            for j in p.start as usize..p.end as usize {
-                let pos = DVec3::new(s.pos_x[j] as f64, s.pos_y[j] as f64, s.pos_z[j] as f64);
-                r2 = r2.max((pos - centre).length_squared());
-            }
-            let r = libm::sqrt(r2).min(f32::MAX as f64);
-            let rounded = r as f32;
-            if (rounded as f64) < r {
-                rounded.next_up()
+        .all(|v| v.is_finite() && v.abs() <= f32::MAX as f64)
+    {
+        cov.map(|v| v as f32)
+    } else {
+        [0.0; 6]
+    };
+    let r = libm::sqrt(r2).min(f32::MAX as f64);
+    let rounded = r as f32;
+    let radius = if (rounded as f64) < r {
+        rounded.next_up()
+    } else {
+        rounded
+    };
+    (cov, radius)
+}
+
+/// Writes the node columns, each node's aggregates summed afresh over its own sample range
+/// (every range is contiguous in Morton order), and returns the root's bounds.
+///
+/// Nothing is held per node but its output: the bottom-up sweep this replaced kept double-
+/// precision sums, centroids and covariances of every node at once (264 bytes per node, about
+/// 100 bytes per sample, the peak of a whole render). The price is that each sample is read
+/// twice per ancestor, O(N · depth), which the radius already cost.
+fn aggregate(pending: &[Pending], s: &Samples) -> (Nodes, Option<(Vec3, Vec3)>) {
+    let padded = pending.len() + LANES;
+    let column = || Vec::with_capacity(padded);
+    let mut d = Nodes {
+        area: column(),
+        flux_r: column(),
+        flux_g: column(),
+        flux_b: column(),
+        centroid_x: column(),
+        centroid_y: column(),
+        centroid_z: column(),
+        radius: column(),
+        cov_xx: column(),
+        cov_yy: column(),
+        cov_zz: column(),
+        cov_xy: column(),
+        cov_xz: column(),
+        cov_yz: column(),
+        first: Vec::with_capacity(padded),
+        info: Vec::with_capacity(padded),
+    };
+    let mut root_bounds = None;
+    for p in pending {
+        let range = p.start as usize..p.end as usize;
+        let sums = Sums::over(s, range.clone());
+        let centre = sums.centroid();
+        let (cov, radius) = spread(s, range, &sums, centre);
+        if root_bounds.is_none() {
+            root_bounds = Some((sums.lo.as_vec3(), sums.hi.as_vec3()));
+        }
+        d.area.push(sums.area as f32);
+        d.flux_r.push(sums.flux.x as f32);
+        d.flux_g.push(sums.flux.y as f32);
+        d.flux_b.push(sums.flux.z as f32);
+        d.centroid_x.push(centre.x as f32);
+        d.centroid_y.push(centre.y as f32);
+        d.centroid_z.push(centre.z as f32);
+        d.radius.push(radius);
+        for (c, v) in [
+            &mut d.cov_xx,
+            &mut d.cov_yy,
+            &mut d.cov_zz,
+            &mut d.cov_xy,
+            &mut d.cov_xz,
+            &mut d.cov_yz,
+        ]
+        .into_iter()
+        .zip(cov)
+        {
+            c.push(v);
+        }
+        d.first.push(p.first);
+        d.info
+            .push((p.count & COUNT_MASK) | if p.leaf { LEAF_BIT } else { 0 });
+    }
+    for c in [
+        &mut d.area,
+        &mut d.flux_r,
+        &mut d.flux_g,
+        &mut d.flux_b,
+        &mut d.centroid_x,
+        &mut d.centroid_y,
+        &mut d.centroid_z,
+        &mut d.radius,
+        &mut d.cov_xx,
+        &mut d.cov_yy,
+        &mut d.cov_zz,
+        &mut d.cov_xy,
+        &mut d.cov_xz,
+        &mut d.cov_yz,
+    ] {
+        c.resize(padded, 0.0);
+    }
+    d.first.resize(padded, 0);
+    d.info.resize(padded, 0);
+    (d, root_bounds)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DMat3;
+
+    /// Every node's aggregates, the independent way: bottom-up over the children in double
+    /// precision, centroids and covariances combined by the parallel-axis theorem
+    /// (C = Σ_c W_c (C_c + (P_c − P)(P_c − P)ᵀ) / W), against what the build stored.
+    fn check_against_bottom_up(samples: &[Sample]) {
+        let cache = IrradianceCache::build(samples).unwrap();
+        cache.validate().unwrap();
+        let (s, d, m) = (&cache.samples, &cache.nodes, cache.node_len);
+        // (area, flux, Σw p, Σw, Σ A p, Σ p, count, lo, hi) per node.
+        #[derive(Clone, Copy)]
+        struct Node {
+            area: f64,
+            flux: DVec3,
+            wp: DVec3,
+            w: f64,
+            ap: DVec3,
+            p: DVec3,
+            n: f64,
+            range: (usize, usize),
+        }
+        let mut nodes = alloc::vec![
+            Node {
+                area: 0.0,
+                flux: DVec3::ZERO,
+                wp: DVec3::ZERO,
+                w: 0.0,
+                ap: DVec3::ZERO,
+                p: DVec3::ZERO,
+                n: 0.0,
+                range: (0, 0),
+            };
+            m
+        ];
+        let mut centre = alloc::vec![DVec3::ZERO; m];
+        let mut cov = alloc::vec![DMat3::ZERO; m];
+        let outer = |v: DVec3| DMat3::from_cols(v * v.x, v * v.y, v * v.z);
+        // How node `i` weighs a sample or child: flux, else area, else count.
+        let weigh = |node: &Node, w: f64, area: f64, n: f64| {
+            if node.w > 0.0 {
+                w
+            } else if node.area > 0.0 {
+                area
             } else {
-                rounded
+                n
             }
-        })
-        .collect()
+        };
+        for i in (0..m).rev() {
+            let (first, count) = (d.first[i] as usize, (d.info[i] & COUNT_MASK) as usize);
+            let leaf = d.info[i] & LEAF_BIT != 0;
+            let mut node = nodes[i];
+            let children = first..first + count;
+            if leaf {
+                node.range = (first, first + count);
+                for j in children.clone() {
+                    let (p, f) = sample_at(s, j);
+                    let w = f.x + f.y + f.z;
+                    node.area += s.area[j] as f64;
+                    node.flux += f;
+                    node.wp += p * w;
+                    node.w += w;
+                    node.ap += p * s.area[j] as f64;
+                    node.p += p;
+                    node.n += 1.0;
+                }
+            } else {
+                node.range = (nodes[first].range.0, nodes[first + count - 1].range.1);
+                for c in children.clone() {
+                    let k = nodes[c];
+                    node.area += k.area;
+                    node.flux += k.flux;
+                    node.wp += k.wp;
+                    node.w += k.w;
+                    node.ap += k.ap;
+                    node.p += k.p;
+                    node.n += k.n;
+                }
+            }
+            let total = weigh(&node, node.w, node.area, node.n);
+            let mut c = if node.w > 0.0 {
+                node.wp / node.w
+            } else if node.area > 0.0 {
+                node.ap / node.area
+            } else {
+                node.p / node.n
+            };
+            let (lo, hi) = (node.range.0..node.range.1)
+                .map(|j| sample_at(s, j).0)
+                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p), hi.max(p))
+                });
+            c = c.clamp(lo, hi);
+            let mut acc = DMat3::ZERO;
+            if leaf {
+                for j in children {
+                    let (p, f) = sample_at(s, j);
+                    acc += outer(p - c) * weigh(&node, f.x + f.y + f.z, s.area[j] as f64, 1.0);
+                }
+            } else {
+                for k in children {
+                    let w = weigh(&node, nodes[k].w, nodes[k].area, nodes[k].n);
+                    acc += (cov[k] + outer(centre[k] - c)) * w;
+                }
+            }
+            nodes[i] = node;
+            centre[i] = c;
+            cov[i] = acc * (1.0 / total.max(f64::MIN_POSITIVE));
+
+            let scale = (hi - lo).length().max(f64::MIN_POSITIVE);
+            let rel = |got: f32, want: f64, of: f64| {
+                assert!(
+                    (got as f64 - want).abs() <= 1e-6 * of + 1e-30,
+                    "node {i}: {got} against {want}"
+                );
+            };
+            rel(d.area[i], node.area, node.area);
+            for (got, want) in [d.flux_r[i], d.flux_g[i], d.flux_b[i]]
+                .into_iter()
+                .zip(node.flux.to_array())
+            {
+                rel(got, want, want);
+            }
+            let stored = DVec3::new(
+                d.centroid_x[i] as f64,
+                d.centroid_y[i] as f64,
+                d.centroid_z[i] as f64,
+            );
+            for (got, want) in stored.to_array().into_iter().zip(c.to_array()) {
+                rel(got as f32, want, scale + want.abs());
+            }
+            let trace = cov[i].x_axis.x + cov[i].y_axis.y + cov[i].z_axis.z;
+            for (got, (a, b)) in [
+                (d.cov_xx[i], (0, 0)),
+                (d.cov_yy[i], (1, 1)),
+                (d.cov_zz[i], (2, 2)),
+                (d.cov_xy[i], (0, 1)),
+                (d.cov_xz[i], (0, 2)),
+                (d.cov_yz[i], (1, 2)),
+            ] {
+                rel(got, cov[i].col(a)[b], trace);
+            }
+            // The radius: the farthest sample from the stored centroid, rounded up by at most
+            // one f32 step.
+            let far = (node.range.0..node.range.1)
+                .map(|j| (sample_at(s, j).0 - stored).length())
+                .fold(0.0f64, f64::max);
+            assert!(d.radius[i] as f64 >= far, "node {i}: radius below a sample");
+            assert!(
+                d.radius[i] as f64 <= far * (1.0 + 2e-7) + 1e-30,
+                "node {i}: radius {} for {far}",
+                d.radius[i]
+            );
+        }
+    }
+
+    /// A pseudo-random sphere with a terminator (unlit nodes fall back to area weights), some
+    /// samples with zero area and, on request, every sample dark and without area (uniform
+    /// weights), or on a few coincident points (count splits).
+    fn samples(n: usize, mode: u32) -> Vec<Sample> {
+        let mut state = 0x2545_f491_4f6c_dd1du64 ^ n as u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|i| {
+                let z = next() * 2.0 - 1.0;
+                let phi = next() * core::f32::consts::TAU;
+                let r = libm::sqrtf((1.0 - z * z).max(0.0));
+                let p = match mode {
+                    2 => Vec3::splat((i % 3) as f32),
+                    _ => Vec3::new(r * libm::cosf(phi), r * libm::sinf(phi), z) * 3.0,
+                };
+                let lit = if mode == 1 { 0.0 } else { p.x.max(0.0) };
+                let area = if mode == 1 || i % 7 == 0 { 0.0 } else { next() };
+                Sample {
+                    position: p + Vec3::new(10.0, -4.0, 2.0),
+                    area,
+                    irradiance: Vec3::new(lit, 0.5 * lit, 0.25 * lit),
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn aggregates_match_the_bottom_up_sums() {
+        for n in [1usize, 8, 9, 100, 5000, 60_000] {
+            check_against_bottom_up(&samples(n, 0));
+        }
+        check_against_bottom_up(&samples(3000, 1));
+        check_against_bottom_up(&samples(3000, 2));
+    }
 }

@@ -6,8 +6,9 @@
 //! by cell (each cell a contiguous run of slots); only occupied tiles and cells are stored:
 //!
 //! ```text
-//! slots:      [ (p, i) (p, i) ... | (p, i) ... | ... ]   16 B per candidate: position, index
+//! slots:      [ (p, w) (p, w) ... | (p, w) ... | ... ]   16 B per candidate: position, weight
 //!               tile 0              tile 1
+//! index:      [ i i ... | i ... | ... ]                  4 B: its index in generation order
 //! tile_start: [ 0, 517, 1032, ... ]                      first slot of each tile (+ end)
 //! tile_cells: [ 0, 83, 170, ... ]                        first cell of each tile (+ end)
 //! cell_key:   [ (x·8 + y)·8 + z, ... ]                   the cell within its tile (u16)
@@ -24,8 +25,14 @@
 //! stored twice (see `poisson.rs`): the first counts the candidates of every tile per chunk
 //! of candidates, the second writes each candidate straight to its slot (a counting sort);
 //! then each tile is sorted by cell on its own.
+//!
+//! Why the weight lives in the slot (and a removal is its weight set to −∞): a gather reads
+//! each candidate's position, whether it is still there and its weight; held together, that
+//! is one stream of memory instead of three (positions, a removal bitmap, a weight column).
+//! The gathers are bound by memory latency, so this cut their time. The index is only needed
+//! at the end, to regenerate the survivors, so it is a column of its own.
 
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -76,11 +83,37 @@ fn compact(v: u64) -> u64 {
     (x | x >> 32) & 0x1f_ffff
 }
 
-/// One candidate: its position and its index in generation order.
+/// One candidate while the tiles are built: its position and its index in generation order.
 #[derive(Clone, Copy, Debug, PartialEq)]
+struct Candidate {
+    position: Vec3,
+    index: u32,
+}
+
+/// One candidate in its tile: its position and its weight (`f32` bits; [`REMOVED`] once it is
+/// eliminated). The weight is shared by the tasks of a phase: a slot is read and written by
+/// one task only (its own tile's, or that of the one tile of the phase whose halo holds it),
+/// so relaxed atomics (plain moves on x86) keep the outcome independent of timing.
+#[derive(Debug)]
 pub(super) struct Slot {
     pub(super) position: Vec3,
-    pub(super) index: u32,
+    weight: AtomicU32,
+}
+
+/// The weight bits of an eliminated candidate (−∞, below any weight).
+pub(super) const REMOVED: u32 = f32::NEG_INFINITY.to_bits();
+
+impl Slot {
+    /// Sets the weight (−∞ removes the candidate).
+    #[inline]
+    pub(super) fn set_weight(&self, w: f32) {
+        self.weight.store(w.to_bits(), Ordering::Relaxed);
+    }
+    /// True once the candidate is eliminated.
+    #[inline]
+    pub(super) fn removed(&self) -> bool {
+        self.weight.load(Ordering::Relaxed) == REMOVED
+    }
 }
 
 /// Where cells lie: the grid's corner and cell edge.
@@ -101,7 +134,9 @@ impl Layout {
 
     fn cell_of(&self, p: Vec3) -> [u64; 3] {
         let q = (p.as_dvec3() - self.origin) / self.cell;
-        [q.x, q.y, q.z].map(|v| v.floor().clamp(0.0, AXIS_MAX as f64) as u64)
+        // Truncation after clamping at 0 is the floor, and the upper clamp commutes with both;
+        // `floor` itself is a library call on the x86-64 baseline (no SSE4.1).
+        [q.x, q.y, q.z].map(|v| v.clamp(0.0, AXIS_MAX as f64) as u64)
     }
 
     /// The key of the tile holding `p`.
@@ -162,6 +197,8 @@ pub(super) struct Tiles {
     cell_start: Vec<u32>,
     /// The candidates, tile by tile and cell by cell.
     pub(super) slots: Vec<Slot>,
+    /// Each slot's candidate index in generation order.
+    pub(super) index: Vec<u32>,
 }
 
 impl Tiles {
@@ -231,11 +268,11 @@ impl Tiles {
         });
         drop(offsets);
         // Reuses the allocation (same size and alignment).
-        let mut slots: Vec<Slot> = scatter
+        let mut slots: Vec<Candidate> = scatter
             .into_iter()
             .map(|s| {
                 let [x, y, z, index] = s.map(AtomicU32::into_inner);
-                Slot {
+                Candidate {
                     position: Vec3::new(f32::from_bits(x), f32::from_bits(y), f32::from_bits(z)),
                     index,
                 }
@@ -253,7 +290,7 @@ impl Tiles {
         let cells: Vec<Vec<(u16, u32)>> = parts
             .into_par_iter()
             .map(|(first, part)| {
-                let mut keyed: Vec<(u16, u32, Slot)> = part
+                let mut keyed: Vec<(u16, u32, Candidate)> = part
                     .iter()
                     .map(|s| (layout.cell_key(s.position), s.index, *s))
                     .collect();
@@ -277,6 +314,15 @@ impl Tiles {
             cell_start.extend(c.iter().map(|&(_, s)| s));
         }
         tile_cells.push(cell_key.len() as u32);
+        let index: Vec<u32> = slots.iter().map(|c| c.index).collect();
+        // Reuses the allocation again: every weight starts at zero.
+        let slots: Vec<Slot> = slots
+            .into_iter()
+            .map(|c| Slot {
+                position: c.position,
+                weight: AtomicU32::new(0),
+            })
+            .collect();
         let neighbours = keys
             .par_iter()
             .map(|&key| {
@@ -310,6 +356,7 @@ impl Tiles {
             cell_key,
             cell_start,
             slots,
+            index,
         }
     }
 
@@ -331,15 +378,9 @@ impl Tiles {
         ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) as usize
     }
 
-    /// Copies tile `t`'s candidates and its halo into `out`, leaving out the slots `skip`
-    /// names, with positions relative to the tile's corner in units of `unit`.
-    pub(super) fn gather(
-        &self,
-        t: usize,
-        unit: f32,
-        skip: impl Fn(u32) -> bool,
-        out: &mut Neighbourhood,
-    ) {
+    /// Copies tile `t`'s candidates and its halo into `out`, with their weights, leaving out
+    /// the removed ones, with positions relative to the tile's corner in units of `unit`.
+    pub(super) fn gather(&self, t: usize, unit: f32, out: &mut Neighbourhood) {
         let k = TILE_CELLS as i64;
         let local = |key: u16, shift: [i64; 3]| -> Option<usize> {
             let c = [key as i64 / (k * k), key as i64 / k % k, key as i64 % k];
@@ -414,14 +455,16 @@ impl Tiles {
                 out.start[next] = out.x.len() as u32;
                 next += 1;
             }
-            for s in a..b {
-                if skip(s) {
+            for (s, slot) in (a..b).zip(&self.slots[a as usize..b as usize]) {
+                let w = slot.weight.load(Ordering::Relaxed);
+                if w == REMOVED {
                     continue;
                 }
-                let q = (self.slots[s as usize].position.as_dvec3() - corner) * inv;
+                let q = (slot.position.as_dvec3() - corner) * inv;
                 out.x.push(q.x as f32);
                 out.y.push(q.y as f32);
                 out.z.push(q.z as f32);
+                out.w.push(f32::from_bits(w));
                 out.cell.push(l as u16);
                 out.slot.push(s);
                 out.own.push(own);
@@ -439,6 +482,7 @@ impl Tiles {
 /// ```text
 /// x, y, z:  [ 0.2  0.9  0.4  8.1 … ]     positions (tile corner = 0), in local cell order
 /// cell:     [ 0    0    111  111 … ]     their local cells, (x·10 + y)·10 + z
+/// w:        [ 3.1  2.7  4.0  3.9 … ]     their weights when gathered
 /// slot:     [ 9    14   1032 1033 … ]    their slots in `Tiles::slots`
 /// own:      [ no   no   yes  yes … ]     the tile's own (else halo)
 /// start:    [ 0, 0, 2, 2, 2, ... ]       first point of each of the 10³ local cells (+ end)
@@ -448,6 +492,7 @@ pub(super) struct Neighbourhood {
     pub(super) x: Vec<f32>,
     pub(super) y: Vec<f32>,
     pub(super) z: Vec<f32>,
+    pub(super) w: Vec<f32>,
     pub(super) cell: Vec<u16>,
     pub(super) slot: Vec<u32>,
     pub(super) own: Vec<bool>,
@@ -461,6 +506,7 @@ impl Default for Neighbourhood {
             x: Vec::new(),
             y: Vec::new(),
             z: Vec::new(),
+            w: Vec::new(),
             cell: Vec::new(),
             slot: Vec::new(),
             own: Vec::new(),
@@ -475,6 +521,7 @@ impl Neighbourhood {
         self.x.clear();
         self.y.clear();
         self.z.clear();
+        self.w.clear();
         self.cell.clear();
         self.slot.clear();
         self.own.clear();
@@ -499,25 +546,6 @@ impl Neighbourhood {
                 k += 1;
             }
         }
-    }
-}
-
-/// A bitmap shared by the tasks of a phase: each task sets only bits of its own tile's slots
-/// and reads others' (of tiles no task of the phase writes), so the outcome does not depend on
-/// timing.
-pub(super) struct Bits(Vec<AtomicU64>);
-
-impl Bits {
-    pub(super) fn new(len: usize) -> Bits {
-        Bits((0..len.div_ceil(64)).map(|_| AtomicU64::new(0)).collect())
-    }
-    #[inline]
-    pub(super) fn get(&self, i: u32) -> bool {
-        self.0[i as usize / 64].load(Ordering::Relaxed) >> (i % 64) & 1 != 0
-    }
-    #[inline]
-    pub(super) fn set(&self, i: u32) {
-        self.0[i as usize / 64].fetch_or(1u64 << (i % 64), Ordering::Relaxed);
     }
 }
 
@@ -624,27 +652,35 @@ mod tests {
         let tiles = Tiles::build(layout, &counts, chunk);
         assert!(tiles.len() > 8);
         let mut seen = vec![false; pts.len()];
-        for s in &tiles.slots {
-            assert!(!seen[s.index as usize]);
-            seen[s.index as usize] = true;
-            assert_eq!(s.position, pts[s.index as usize]);
+        for (s, &i) in tiles.slots.iter().zip(&tiles.index) {
+            assert!(!seen[i as usize]);
+            seen[i as usize] = true;
+            assert_eq!(s.position, pts[i as usize]);
         }
         let skipped = |s: u32| s % 7 == 3;
+        for (s, slot) in tiles.slots.iter().enumerate() {
+            slot.set_weight(if skipped(s as u32) {
+                f32::NEG_INFINITY
+            } else {
+                s as f32
+            });
+        }
         let mut near = Neighbourhood::default();
         let mut runs = [(0, 0); 9];
         let mut owned = 0;
         for t in 0..tiles.len() {
             let range = tiles.slot_range(t);
-            assert!(tiles.slots[range.clone()].windows(2).all(|w| (
-                layout.cell_key(w[0].position),
-                w[0].index
-            ) < (
-                layout.cell_key(w[1].position),
-                w[1].index
-            )));
-            tiles.gather(t, 0.5, skipped, &mut near);
+            let key = |s: usize| (layout.cell_key(tiles.slots[s].position), tiles.index[s]);
+            assert!(
+                range
+                    .clone()
+                    .zip(range.clone().skip(1))
+                    .all(|(a, b)| key(a) < key(b))
+            );
+            tiles.gather(t, 0.5, &mut near);
             for i in 0..near.len() {
                 assert!(!skipped(near.slot[i]));
+                assert_eq!(near.w[i], near.slot[i] as f32);
                 if !near.own[i] {
                     assert!(!range.contains(&(near.slot[i] as usize)));
                     continue;

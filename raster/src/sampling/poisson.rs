@@ -44,30 +44,32 @@
 //! be regenerated at will, by any thread. A first pass counts the candidates per tile, a
 //! second writes each one's position and index straight to its slot (a counting sort), and
 //! after the elimination a third regenerates the blocks and keeps the survivors. What is held
-//! per candidate is its slot (position and index, 16 B), its weight (4 B) and a removal bit;
-//! per sample (five candidates) about 105 B, then 24 B for the output. The tiles' cell lists
-//! and neighbour tables are a few bytes per sample.
+//! per candidate is its slot (position and weight, 16 B; a removal sets the weight to −∞) and
+//! its index (4 B): per sample (five candidates) about 105 B, then 24 B for the output, the
+//! peak of a whole render (the cache build holds less). The tiles' cell lists and neighbour
+//! tables are a few bytes per sample.
 //!
 //! **Cost.** Each weight is summed once (9 contiguous runs of the 27 cells around it, ~130
 //! candidates, vectorised), each removal updates the same runs and a small per-tile max-tree
 //! (`maxtree.rs`), and every round gathers each tile with its halo again; all of it in a few
 //! KB of local memory, so the elimination is bound by arithmetic instead of the memory latency
 //! of the former sequential elimination over the whole set (22 s for 1M samples, one thread).
-//! About 5.5 s of CPU for 1M samples on this machine, spread over the cores by the phases; the
-//! three generation passes are ~15% of it.
+//! About 6.8 s of CPU for 1M samples on the sphere with two threads on this machine, spread
+//! over the cores by the phases (`examples/placement_cost.rs`; figures in `BENCHMARKS.md`).
+//! By perf, the largest parts are the gathers (about a quarter: memory latency on the halo's
+//! slots, which is why a slot holds its weight and removal), the max-tree updates, the
+//! weight sums and removals, and the three generation passes (~15%).
 //!
 //! Alternatives considered: dart throwing cannot hit an exact count; keeping each candidate's
 //! neighbour list instead of re-scanning cells costs ~18 entries per candidate (~360 MB at 1M
 //! samples); recomputing the weights at every round instead of writing back the halo's cost
 //! 25% more time.
 
-use std::sync::atomic::{AtomicU32, Ordering};
-
 use glam::Vec3;
 use rayon::prelude::*;
 
 use super::error::SamplingError;
-use super::grid::{Bits, ChunkCounts, Layout, Neighbourhood, Tiles, count_tiles};
+use super::grid::{ChunkCounts, Layout, Neighbourhood, Tiles, count_tiles};
 use super::maxtree::MaxTree;
 use super::rng::{Pcg32, splitmix64};
 use super::strata::Strata;
@@ -173,17 +175,15 @@ pub fn poisson_samples_with_progress(
     for t in 0..tiles.len() {
         by_colour[tiles.colour(t)].push(t as u32);
     }
-    let removed = Bits::new(m);
     let kernel = Kernel::new(d_min / d_max);
     // Every candidate's weight, summed once over its neighbours (any order: nothing changes
     // yet), then kept up to date by the removals. Each slot is written by one task only: its
     // own tile's, or that of the one tile of the phase whose halo holds it (tiles of a colour
     // are a tile apart, and halos one cell deep).
-    let weights: Vec<AtomicU32> = (0..m).map(|_| AtomicU32::new(0)).collect();
     (0..tiles.len())
         .into_par_iter()
         .for_each_init(Scratch::default, |scratch, t| {
-            sum_weights(&tiles, t, d_max, &kernel, &weights, scratch)
+            sum_weights(&tiles, t, d_max, &kernel, scratch)
         });
     for (round, &left) in SCHEDULE.iter().enumerate() {
         for c in 0..8 {
@@ -195,11 +195,7 @@ pub fn poisson_samples_with_progress(
                     let count = tiles.slot_range(t).len();
                     let q = quota[t] as usize;
                     let keep = q + ((count - q) as f64 * left) as usize;
-                    let state = State {
-                        removed: &removed,
-                        weights: &weights,
-                    };
-                    eliminate(&tiles, t, keep, d_max, &kernel, state, scratch);
+                    eliminate(&tiles, t, keep, d_max, &kernel, scratch);
                 });
             advance();
         }
@@ -207,14 +203,12 @@ pub fn poisson_samples_with_progress(
 
     // 4. The survivors, regenerated from their streams.
     let mut keep = vec![0u64; blocks * BLOCK / 64];
-    for (s, slot) in tiles.slots.iter().enumerate() {
-        if !removed.get(s as u32) {
-            keep[slot.index as usize / 64] |= 1 << (slot.index % 64);
+    for (slot, &i) in tiles.slots.iter().zip(&tiles.index) {
+        if !slot.removed() {
+            keep[i as usize / 64] |= 1 << (i % 64);
         }
     }
     drop(tiles);
-    drop(removed);
-    drop(weights);
     let per_block: Vec<usize> = keep
         .chunks(BLOCK / 64)
         .map(|w| w.iter().map(|x| x.count_ones() as usize).sum())
@@ -261,25 +255,10 @@ struct Scratch {
     sign: Vec<f32>,
 }
 
-/// The shared state of the elimination: which slots are removed, and every slot's weight
-/// (`f32` bits).
-#[derive(Clone, Copy)]
-struct State<'a> {
-    removed: &'a Bits,
-    weights: &'a [AtomicU32],
-}
-
-/// Sums the weights of tile `t`'s candidates over their neighbourhoods, into `weights`.
-fn sum_weights(
-    tiles: &Tiles,
-    t: usize,
-    d_max: f32,
-    kernel: &Kernel,
-    weights: &[AtomicU32],
-    scratch: &mut Scratch,
-) {
+/// Sums the weights of tile `t`'s candidates over their neighbourhoods, into their slots.
+fn sum_weights(tiles: &Tiles, t: usize, d_max: f32, kernel: &Kernel, scratch: &mut Scratch) {
     let near = &mut scratch.near;
-    tiles.gather(t, d_max, |_| false, near);
+    tiles.gather(t, d_max, near);
     let mut runs = [(0u32, 0u32); 9];
     for i in 0..near.len() {
         if near.own[i] {
@@ -289,7 +268,7 @@ fn sum_weights(
                 .iter()
                 .map(|&(a, b)| kernel.sum(p, near, a as usize..b as usize))
                 .sum();
-            weights[near.slot[i] as usize].store(w.to_bits(), Ordering::Relaxed);
+            tiles.slots[near.slot[i] as usize].set_weight(w);
         }
     }
 }
@@ -306,11 +285,10 @@ fn eliminate(
     keep: usize,
     d_max: f32,
     kernel: &Kernel,
-    state: State,
     scratch: &mut Scratch,
 ) {
     let near = &mut scratch.near;
-    tiles.gather(t, d_max, |s| state.removed.get(s), near);
+    tiles.gather(t, d_max, near);
     let mut alive = near.own.iter().filter(|&&o| o).count();
     if alive <= keep {
         return;
@@ -318,9 +296,8 @@ fn eliminate(
     let (w, sign) = (&mut scratch.weights, &mut scratch.sign);
     w.clear();
     sign.clear();
-    for i in 0..near.len() {
-        let s = if near.own[i] { 1.0 } else { -1.0 };
-        let x = f32::from_bits(state.weights[near.slot[i] as usize].load(Ordering::Relaxed));
+    for (&own, &x) in near.own.iter().zip(&near.w) {
+        let s = if own { 1.0 } else { -1.0 };
         w.push(s * x);
         sign.push(s);
     }
@@ -331,7 +308,6 @@ fn eliminate(
         let i = i as usize;
         debug_assert!(near.own[i] && w[i] > 0.0);
         w[i] = f32::NEG_INFINITY;
-        state.removed.set(near.slot[i]);
         alive -= 1;
         near.runs_near(near.cell[i], &mut runs);
         let p = [near.x[i], near.y[i], near.z[i]];
@@ -341,11 +317,9 @@ fn eliminate(
         }
         tree.update_ranges(w, |&x| x, &runs);
     }
-    for i in 0..near.len() {
-        if w[i] != f32::NEG_INFINITY {
-            let x = sign[i] * w[i];
-            state.weights[near.slot[i] as usize].store(x.to_bits(), Ordering::Relaxed);
-        }
+    // The removed (own) candidates are written back as −∞: removed.
+    for ((&slot, &s), &x) in near.slot.iter().zip(sign.iter()).zip(w.iter()) {
+        tiles.slots[slot as usize].set_weight(s * x);
     }
 }
 
