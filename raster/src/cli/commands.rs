@@ -244,7 +244,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         let s = &result.stats;
         let t = &s.timings;
         println!(
-            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel, {} pixels refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
+            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
@@ -260,6 +260,8 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             s.queries,
             s.shading_points as f64
                 / (f64::from(scene.camera.width) * f64::from(scene.camera.height)),
+            seconds(t.refine),
+            s.probed_pixels,
             s.refined_pixels,
             s.probes,
             seconds(t.total),

@@ -118,8 +118,11 @@ pub struct Timings {
     pub cache: Duration,
     /// Rasterisation.
     pub raster: Duration,
-    /// Shading every pixel.
+    /// Shading every pixel (both passes).
     pub shading: Duration,
+    /// Of that, the second pass: probing the pixels next to a change and shading again those
+    /// whose sub-samples differ.
+    pub refine: Duration,
     /// Everything.
     pub total: Duration,
 }
@@ -143,6 +146,8 @@ pub struct RenderStats {
     /// Sub-samples probed to decide where to shade more than once (one shadow ray per light
     /// each).
     pub probes: u64,
+    /// Pixels probed by the second pass (their radiance differs from a neighbour's).
+    pub probed_pixels: u64,
     /// Pixels shaded a second time, at more than one point per object.
     pub refined_pixels: u64,
     /// Traversal counters, if collected.
@@ -438,7 +443,7 @@ fn render_in_pool(
     let mut traversal = QueryStats::default();
     let mut translucent_time = Duration::ZERO;
     let (mut shading_points, mut queries) = (0, 0);
-    let (mut probes, mut refined_pixels) = (0, 0);
+    let (mut probes, mut probed_pixels, mut refined_pixels) = (0, 0, 0);
     for row in rows {
         let row = row?;
         let counted = row.stats.traversal;
@@ -452,6 +457,7 @@ fn render_in_pool(
     }
     // Second pass: where the shading varies within a pixel, more points.
     if scene.render.aa > 1 && !options.shade_once {
+        let t = Instant::now();
         let refined = refine::refine(&shading, &mut pixels, options.collect_stats)?;
         let counted = refined.stats.traversal;
         traversal.nodes_opened += counted.nodes_opened;
@@ -463,6 +469,8 @@ fn render_in_pool(
         queries += refined.queries;
         probes = refined.probes;
         refined_pixels = refined.reshaded;
+        probed_pixels = refined.flagged;
+        timings.refine = t.elapsed();
     }
     traversal.queries = queries;
     timings.shading = t.elapsed();
@@ -485,6 +493,7 @@ fn render_in_pool(
             shading_points,
             queries,
             probes,
+            probed_pixels,
             refined_pixels,
             traversal: options.collect_stats.then_some(traversal),
             translucent_time: options.collect_stats.then_some(translucent_time),
