@@ -5,8 +5,9 @@
 //! at its representative sub-sample (the covered one nearest the pixel centre) and weighted by
 //! its coverage. That antialiases silhouettes between objects, but not what changes *within*
 //! an object's part of a pixel: a hard shadow edge, a crease, a texture edge. Those stayed
-//! stair-stepped at any `aa`. Here each fragment of coverage ≥ 2 is checked, and split where
-//! needed:
+//! stair-stepped at any `aa`. In the pixels the second pass picks ([`super::refine`]: those
+//! whose first-pass radiance differs from a neighbour's), each fragment of coverage ≥ 2 is
+//! checked, and split where needed:
 //!
 //! 1. **Probe the hull.** Each covered sub-sample's *signature* is: which lights reach it (one
 //!    shadow ray per light, [`Lighting::reach_mask`]), its shading normal, and for a textured
@@ -14,16 +15,16 @@
 //!    equal, the normals are within [`NORMAL_COS`] (about 10°) and every channel's K_d and ℓ_u
 //!    within [`MATERIAL_TOLERANCE`] relative. Only the vertices of the convex hull of the
 //!    fragment's sub-sample positions are probed first (the four corners of a fully covered
-//!    pixel). A straight shadow edge splits the plane into two half-planes, and a half-plane
-//!    that holds a covered sub-sample holds a hull vertex, so if every hull vertex matches the
-//!    first one, no straight edge crosses the fragment: it is shaded once, exactly as without
-//!    this step (same point, same seed, same bits).
+//!    pixel). A straight edge splits the plane into two half-planes, and a half-plane that
+//!    holds a covered sub-sample holds a hull vertex, so if every hull vertex matches the
+//!    first one, no straight edge crosses the fragment: it keeps its one shading point.
 //! 2. **Group.** Otherwise every covered sub-sample is probed and, in centre order, joins the
 //!    first group whose leader it matches, or leads a new group, up to [`MAX_GROUPS`]; past
 //!    that it joins the first group with the same light mask (else the first group). Each
 //!    group is shaded once at its leader (its sub-sample nearest the pixel centre) and weighted
 //!    by its share of the pixel's sub-samples. The first group is led by the fragment's
-//!    representative, so the depth layer and the seed of that point are unchanged.
+//!    representative, with the fragment's seed, so that point is the first pass's, and the
+//!    depth layer is unchanged.
 //!
 //! Every layer (radiance, exitance, local, global, irradiance) is the same coverage-weighted
 //! sum over the shading points, so the layers stay consistent with one another: each is the
@@ -36,9 +37,9 @@
 //! smoothly, so one point per side of that ray's edge is what it needs). Everything is a
 //! function of the pixel's own sub-samples, so the image is the same for any thread count.
 //!
-//! Cost (measured, README "Shading antialiasing"): four shadow rays per light per fully covered
-//! pixel, plus a probe of every sub-sample and one more shading point per extra group where a
-//! fragment is split.
+//! Cost: four probes (attributes and one shadow ray per light) per fully covered fragment of a
+//! probed pixel, every sub-sample's probe where it is split, and the points of a split pixel
+//! (measured in the README, "Shading antialiasing").
 
 use glam::{Vec2, Vec3};
 

@@ -2,14 +2,17 @@
 //!
 //! ```text
 //! scene ─ prepare ─┬─ samples (Poisson) ─ irradiance (shadow rays) ─ caches + K tables ─┐
-//!                  └─ rasterise (fixed point, supersampled visibility) ───────────────────┴─ shade ─ image
+//!                  └─ rasterise (fixed point, supersampled visibility) ───────────────────┴─ shade ─ refine ─ image
 //! ```
 //!
 //! Work a scene does not need is skipped: no samples, caches or tables without translucent
 //! objects; no BVH or shadow rays when nothing can occlude; no K tables for the unsplit
 //! methods, and table entries only for the ℓ the shading points ask for. Shading runs on a
 //! rayon pool over rows; every pixel depends only on its coordinates, so the image is the same
-//! for any thread count.
+//! for any thread count. With `aa > 1`, a second pass (`refine`, `adaptive`) re-shades the
+//! pixels whose sub-samples see different light, normals or material at one point per group of
+//! alike sub-samples; it reads the first pass's image and writes only its own pixels, so it is
+//! deterministic too.
 
 mod adaptive;
 mod attributes;
