@@ -8,10 +8,14 @@
 //!   coverage-only antialiasing's (one shading point per pixel);
 //! - every such pixel is shaded again at exactly two points (lit and shadowed), every other
 //!   pixel once, with the same bits as without shading antialiasing;
+//! - the same at a texture edge (a K_d step far sharper than a pixel);
 //! - a scene without an edge shades once per pixel and gives the same bits as without it;
 //! - the image is the same for 1, 2 and 8 threads.
 
+use std::borrow::Cow;
+
 use lucent_core::glam::Vec3;
+use lucent_raster::output::png::write_png_rgb8;
 use lucent_raster::render::{Render, RenderOptions, render};
 use lucent_raster::scene::{Scene, SceneOrigin, parse_scene};
 
@@ -239,4 +243,100 @@ fn the_refined_image_is_the_same_for_any_thread_count() {
         );
         assert_eq!(one.stats.probes, other.stats.probes);
     }
+}
+
+/// A K_d texture 1024 texels wide: dark (sRGB 60) on the left half, bright (230) on the right,
+/// on the plane of [`edge_scene`] rotated 20° about z and lit without shadows: the step is
+/// a straight line at 20° to the columns, a fifth of a pixel wide after bilinear filtering.
+fn texture_scene(size: u32, aa: u32) -> Scene {
+    let dir = std::env::temp_dir().join(format!("lucent-shading-aa-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("kd-{size}-{aa}.png"));
+    let rgb: Vec<u8> = (0..1024)
+        .flat_map(|i| [if i < 512 { 60u8 } else { 230 }; 3])
+        .collect();
+    write_png_rgb8(&path, 1024, 1, &rgb).unwrap();
+    let png = std::fs::read(&path).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 0.0, 1.5]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 40.0
+width = {size}
+height = {size}
+
+[[object]]
+name = "slab"
+shape = "plane"
+size = [4.0, 4.0]
+rotate = [0.0, 0.0, 20.0]
+material = "wax"
+
+[material.wax]
+type = "translucent"
+kd = {{ texture = "kd.png" }}
+mean_free_path = 0.001
+eta = 1.3
+
+[[light]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = 2.0
+
+[render]
+method = "local-global"
+samples = 2000
+aa = {aa}
+threads = 2
+"#
+    );
+    parse_scene(
+        &text,
+        &SceneOrigin::Embedded {
+            name: "texture.toml".into(),
+            files: vec![("kd.png".into(), Cow::Owned(png))],
+        },
+    )
+    .expect("test scene parses")
+}
+
+#[test]
+fn a_sharp_texture_edge_converges_to_the_supersampled_reference() {
+    let hi = run(&texture_scene(SIZE * 4, 1), false);
+    let n = SIZE as usize;
+    let mut reference = vec![Vec3::ZERO; n * n];
+    let mut edge = vec![false; n * n];
+    let lit = hi.pixels.iter().map(|p| p.color.x).fold(0.0f32, f32::max);
+    for y in 0..n {
+        for x in 0..n {
+            let (mut lo, mut up) = (f32::INFINITY, 0.0f32);
+            for j in 0..4 {
+                for i in 0..4 {
+                    let c = hi.pixels[(4 * y + j) * 4 * n + 4 * x + i].color;
+                    reference[y * n + x] += c / 16.0;
+                    lo = lo.min(c.x);
+                    up = up.max(c.x);
+                }
+            }
+            edge[y * n + x] = up - lo > 0.25 * lit;
+        }
+    }
+    let crossed = edge.iter().filter(|&&e| e).count();
+    assert!((40..=70).contains(&crossed), "{crossed} pixels on the edge");
+    let scene = texture_scene(SIZE, 4);
+    let once = run(&scene, true);
+    let adaptive = run(&scene, false);
+    let before = edge_error(&once, &reference, &edge, lit);
+    let after = edge_error(&adaptive, &reference, &edge, lit);
+    eprintln!(
+        "texture edge pixels {crossed}: relative RMSE one point per pixel {before:.5}, \
+         adaptive {after:.5} (ratio {:.4})",
+        after / before
+    );
+    assert!(before > 0.1, "the stair-steps are visible: {before}");
+    assert!(after <= 0.25 * before, "{after} vs {before}");
+    assert!(adaptive.stats.refined_pixels >= crossed as u64);
 }

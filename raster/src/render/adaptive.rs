@@ -18,11 +18,16 @@
 //!    pixel). A straight edge splits the plane into two half-planes, and a half-plane that
 //!    holds a covered sub-sample holds a hull vertex, so if every hull vertex matches the
 //!    first one, no straight edge crosses the fragment: it keeps its one shading point.
-//! 2. **Group.** Otherwise every covered sub-sample is probed and, in centre order, joins the
-//!    first group whose leader it matches, or leads a new group, up to [`MAX_GROUPS`]; past
-//!    that it joins the first group with the same light mask (else the first group). Each
-//!    group is shaded once at its leader (its sub-sample nearest the pixel centre) and weighted
-//!    by its share of the pixel's sub-samples. The first group is led by the fragment's
+//! 2. **Group.** Otherwise every covered sub-sample is probed, and leaders are chosen by
+//!    farthest points: the representative first, then, while some sub-sample matches no
+//!    leader and there are fewer than [`MAX_GROUPS`], the one the nearest leader stands for
+//!    worst (other lights first, then [`Signature::distance`]; the first in centre order on
+//!    ties). Every sub-sample then joins the leader that stands for it best. Each group is
+//!    shaded once at its leader and weighted by its share of the pixel's sub-samples; on a
+//!    shadow edge (two light masks) that is the sub-sample nearest the pixel centre on each
+//!    side. Choosing the extremes matters where K_d or ℓ_u ramps within a pixel (a
+//!    bilinear texture step): leaders taken in centre order spent the groups on the ramp's
+//!    middle and put the far side in with them. The first group is led by the fragment's
 //!    representative, with the fragment's seed, so that point is the first pass's, and the
 //!    depth layer is unchanged.
 //!
@@ -90,11 +95,36 @@ struct Signature {
     mask: u32,
     /// Shading normal.
     normal: Vec3,
-    /// K_d and ℓ_u per channel, for textured translucent materials.
+    /// K_d (Rd_total, what the eye sees: the reduced albedo α′ bunches up near 1) and ℓ_u per
+    /// channel, for textured translucent materials.
     material: Option<[Vec3; 2]>,
 }
 
 impl Signature {
+    /// Stands in for a sub-sample not probed (never the case once probed; matches nothing).
+    const UNKNOWN: Signature = Signature {
+        mask: u32::MAX,
+        normal: Vec3::ZERO,
+        material: None,
+    };
+
+    /// How far apart two signatures are in what shading sees, for a sub-sample that matches
+    /// no group once there are [`MAX_GROUPS`]: the largest relative difference of K_d and
+    /// ℓ_u, plus the normals' 1 − cos scaled so that [`NORMAL_COS`] counts as much as
+    /// [`MATERIAL_TOLERANCE`].
+    fn distance(&self, other: &Signature) -> f32 {
+        let relative = |a: Vec3, b: Vec3| {
+            ((a - b).abs() / a.abs().max(b.abs()).max(Vec3::splat(f32::MIN_POSITIVE))).max_element()
+        };
+        let material = match (&self.material, &other.material) {
+            (Some(a), Some(b)) => relative(a[0], b[0]).max(relative(a[1], b[1])),
+            (None, None) => 0.0,
+            _ => f32::INFINITY,
+        };
+        let turn = (1.0 - self.normal.dot(other.normal)) / (1.0 - NORMAL_COS) * MATERIAL_TOLERANCE;
+        material + turn
+    }
+
     fn matches(&self, other: &Signature) -> bool {
         let close = |a: Vec3, b: Vec3| {
             ((a - b)
@@ -265,35 +295,52 @@ impl Shading<'_> {
             leaders,
             ..
         } = scratch;
+        for c in covered.iter_mut() {
+            self.probe(x, y, fragment.key, c, &lighting, shadows, probes);
+        }
+        let sig = |c: &Covered| c.signature.unwrap_or(Signature::UNKNOWN);
+        // How badly leader `l` stands for sub-sample `c`: other lights first, then distance.
+        let rank = |l: usize, c: usize| {
+            let (a, b) = (sig(&covered[l]), sig(&covered[c]));
+            (a.mask != b.mask, a.distance(&b))
+        };
+        let worse = |a: (bool, f32), b: (bool, f32)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1));
+        // Farthest-point leaders: the representative, then repeatedly the sub-sample that no
+        // leader matches and the nearest leader stands for worst (the first such in centre
+        // order), while there is one and room for it.
         leaders.clear();
-        for c in 0..covered.len() {
-            let s = self.probe(
-                x,
-                y,
-                fragment.key,
-                &mut covered[c],
-                &lighting,
-                shadows,
-                probes,
-            );
-            // Leaders are probed before anyone joins them.
-            let leader_matches = |g: &(usize, u32), test: &dyn Fn(&Signature) -> bool| {
-                covered[g.0].signature.as_ref().is_some_and(test)
-            };
-            let joined = leaders
-                .iter()
-                .position(|g| leader_matches(g, &|l| l.matches(&s)));
-            let g = match joined {
-                Some(g) => g,
-                None if leaders.len() < MAX_GROUPS => {
-                    leaders.push((c, 0));
-                    leaders.len() - 1
-                }
-                None => leaders
+        leaders.push((0, 0));
+        while leaders.len() < MAX_GROUPS {
+            let mut worst: Option<(usize, (bool, f32))> = None;
+            for c in 0..covered.len() {
+                if leaders
                     .iter()
-                    .position(|g| leader_matches(g, &|l| l.mask == s.mask))
-                    .unwrap_or(0),
-            };
+                    .any(|&(l, _)| sig(&covered[l]).matches(&sig(&covered[c])))
+                {
+                    continue;
+                }
+                let best = leaders
+                    .iter()
+                    .map(|&(l, _)| rank(l, c))
+                    .min_by(|&a, &b| worse(a, b))
+                    .unwrap_or((true, f32::INFINITY));
+                if worst.is_none_or(|(_, w)| worse(best, w).is_gt()) {
+                    worst = Some((c, best));
+                }
+            }
+            match worst {
+                Some((c, _)) => leaders.push((c, 0)),
+                None => break,
+            }
+        }
+        // Each sub-sample joins the leader that stands for it best (the first on ties).
+        for c in 0..covered.len() {
+            let mut g = 0;
+            for k in 1..leaders.len() {
+                if worse(rank(leaders[k].0, c), rank(leaders[g].0, c)).is_lt() {
+                    g = k;
+                }
+            }
             leaders[g].1 += 1;
         }
         let aa = self.visibility.aa() as f32;
@@ -358,7 +405,7 @@ impl Shading<'_> {
             Shader::Translucent(shader) if shader.is_textured() => shader
                 .at(a.uv)
                 .ok()
-                .map(|m| [m.profile.albedo(), m.profile.mean_free_path()]),
+                .map(|m| [m.profile.total_reflectance(), m.profile.mean_free_path()]),
             _ => None,
         };
         let s = Signature {
