@@ -193,6 +193,7 @@ pub fn median_timings(all: &[Timings]) -> Timings {
         cache: m(|t| t.cache),
         raster: m(|t| t.raster),
         shading: m(|t| t.shading),
+        refine: m(|t| t.refine),
         total: m(|t| t.total),
     }
 }

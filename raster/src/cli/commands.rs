@@ -244,7 +244,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         let s = &result.stats;
         let t = &s.timings;
         println!(
-            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries), total {}, cache {:.1} MB, {} threads → {}",
+            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
@@ -258,6 +258,12 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             seconds(t.raster),
             seconds(t.shading),
             s.queries,
+            s.shading_points as f64
+                / (f64::from(scene.camera.width) * f64::from(scene.camera.height)),
+            seconds(t.refine),
+            s.probed_pixels,
+            s.refined_pixels,
+            s.probes,
             seconds(t.total),
             s.cache_bytes as f64 / 1e6,
             s.threads,

@@ -5,7 +5,10 @@
 //! [resolves](VisibilityBuffer::resolve) each pixel into one [`Fragment`] per visible surface,
 //! shades that fragment once at a representative sub-sample, using
 //! [`perspective_barycentrics`] to interpolate vertex attributes, and weights it by
-//! `coverage / aa²`. Antialiasing thus costs sub-sample *coverage*, not sub-sample *shading*.
+//! `coverage / aa²`. Antialiasing thus costs sub-sample *coverage*, not sub-sample *shading*,
+//! except where a fragment's sub-samples see different light, normals or material: the
+//! renderer's second pass (`render::adaptive`) splits those fragments into a few groups of
+//! sub-samples, each shaded once.
 //!
 //! Pipeline of [`VisibilityBuffer::rasterize_triangle`], one module per stage:
 //!

@@ -201,6 +201,12 @@ impl VisibilityBuffer {
         &self.triangle
     }
 
+    /// Indices `j·aa + i` of a pixel's sub-samples, nearest to the pixel centre first (ties in
+    /// index order): the order in which [`resolve`](Self::resolve) picks representatives.
+    pub fn centre_order(&self) -> &[u8] {
+        &self.centre_order
+    }
+
     /// `(triangle id, depth)` of sub-sample `(i, j)` of pixel `(x, y)`; `None` when out of
     /// range or empty.
     pub fn sample(&self, x: u32, y: u32, i: u32, j: u32) -> Option<(u32, f32)> {

@@ -2,20 +2,26 @@
 //!
 //! ```text
 //! scene ─ prepare ─┬─ samples (Poisson) ─ irradiance (shadow rays) ─ caches + K tables ─┐
-//!                  └─ rasterise (fixed point, supersampled visibility) ───────────────────┴─ shade ─ image
+//!                  └─ rasterise (fixed point, supersampled visibility) ───────────────────┴─ shade ─ refine ─ image
 //! ```
 //!
 //! Work a scene does not need is skipped: no samples, caches or tables without translucent
 //! objects; no BVH or shadow rays when nothing can occlude; no K tables for the unsplit
 //! methods, and table entries only for the ℓ the shading points ask for. Shading runs on a
 //! rayon pool over rows; every pixel depends only on its coordinates, so the image is the same
-//! for any thread count.
+//! for any thread count. With `aa > 1`, a second pass (`refine`, `adaptive`) re-shades the
+//! pixels whose sub-samples see different light, normals or material at one point per group of
+//! alike sub-samples; it reads the first pass's image and writes only its own pixels, so it is
+//! deterministic too.
 
+mod adaptive;
+mod attributes;
 mod baked;
 mod convexity;
 pub mod density;
 mod irradiance;
 mod prepare;
+mod refine;
 mod shading;
 
 use std::borrow::Cow;
@@ -27,6 +33,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use lucent_core::{IrradianceCache, Method, NoStats, QuerySettings, QueryStats};
 use rayon::prelude::*;
 
+pub use adaptive::{GroupScratch, ShadeGroup};
 pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
 pub use convexity::cannot_shadow_itself;
 pub use density::{DensityOrigin, DensityPlan};
@@ -95,6 +102,10 @@ pub struct RenderOptions<'a> {
     /// do not need it (hierarchical, exhaustive), so that the irradiance layer is complete.
     /// Implied when the scene asks for the `irradiance` EXR layer.
     pub irradiance_layer: bool,
+    /// Shade every fragment once at its representative sub-sample (coverage-only
+    /// antialiasing), instead of splitting fragments whose sub-samples see different light,
+    /// normals or material (the `adaptive` module). For measurements and tests.
+    pub shade_once: bool,
 }
 
 /// Wall-clock time per phase.
@@ -110,8 +121,11 @@ pub struct Timings {
     pub cache: Duration,
     /// Rasterisation.
     pub raster: Duration,
-    /// Shading every pixel.
+    /// Shading every pixel (both passes).
     pub shading: Duration,
+    /// Of that, the second pass: probing the pixels next to a change and shading again those
+    /// whose sub-samples differ.
+    pub refine: Duration,
     /// Everything.
     pub total: Duration,
 }
@@ -127,10 +141,18 @@ pub struct RenderStats {
     pub warning: Option<String>,
     /// Bytes held by the irradiance caches.
     pub cache_bytes: usize,
-    /// Surfaces shaded (one per pixel and visible object).
+    /// Points shaded: one per pixel and visible object in the first pass, and every point of
+    /// the pixels the second pass shades again ([`RenderStats::refined_pixels`]).
     pub shading_points: u64,
-    /// Translucent shading points (cache queries).
+    /// Translucent shading points (cache queries), both passes.
     pub queries: u64,
+    /// Sub-samples probed to decide where to shade more than once (one shadow ray per light
+    /// each).
+    pub probes: u64,
+    /// Pixels probed by the second pass (their radiance differs from a neighbour's).
+    pub probed_pixels: u64,
+    /// Pixels shaded a second time, at more than one point per object.
+    pub refined_pixels: u64,
     /// Traversal counters, if collected.
     pub traversal: Option<QueryStats>,
     /// CPU time of the translucent shading points summed over threads, if collected (see
@@ -409,11 +431,11 @@ fn render_in_pool(
                 } else {
                     shading.pixel(x as u32, y as u32, &mut scratch, &mut NoStats)?
                 };
-                let fragments = &scratch.fragments;
-                row.points += fragments.len() as u64;
-                row.queries += fragments
+                let groups = &scratch.groups.groups;
+                row.points += groups.len() as u64;
+                row.queries += groups
                     .iter()
-                    .filter(|f| shading.caches[f.key as usize].is_some())
+                    .filter(|g| shading.caches[g.fragment.key as usize].is_some())
                     .count() as u64;
             }
             b.inc(1);
@@ -424,6 +446,7 @@ fn render_in_pool(
     let mut traversal = QueryStats::default();
     let mut translucent_time = Duration::ZERO;
     let (mut shading_points, mut queries) = (0, 0);
+    let (mut probes, mut probed_pixels, mut refined_pixels) = (0, 0, 0);
     for row in rows {
         let row = row?;
         let counted = row.stats.traversal;
@@ -434,6 +457,23 @@ fn render_in_pool(
         translucent_time += row.stats.translucent_time;
         shading_points += row.points;
         queries += row.queries;
+    }
+    // Second pass: where the shading varies within a pixel, more points.
+    if scene.render.aa > 1 && !options.shade_once {
+        let t = Instant::now();
+        let refined = refine::refine(&shading, &mut pixels, options.collect_stats)?;
+        let counted = refined.stats.traversal;
+        traversal.nodes_opened += counted.nodes_opened;
+        traversal.aggregates += counted.aggregates;
+        traversal.samples += counted.samples;
+        traversal.culled += counted.culled;
+        translucent_time += refined.stats.translucent_time;
+        shading_points += refined.points;
+        queries += refined.queries;
+        probes = refined.probes;
+        refined_pixels = refined.reshaded;
+        probed_pixels = refined.flagged;
+        timings.refine = t.elapsed();
     }
     traversal.queries = queries;
     timings.shading = t.elapsed();
@@ -455,6 +495,9 @@ fn render_in_pool(
             cache_bytes,
             shading_points,
             queries,
+            probes,
+            probed_pixels,
+            refined_pixels,
             traversal: options.collect_stats.then_some(traversal),
             translucent_time: options.collect_stats.then_some(translucent_time),
             timings,

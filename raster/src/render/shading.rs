@@ -1,5 +1,6 @@
 //! Shading one pixel: one shading point per visible surface (the representative sub-sample of
-//! each fragment group), weighted by its coverage.
+//! each fragment group), or more where its sub-samples see different light, normals or
+//! material ([`super::adaptive`]), each weighted by its coverage.
 //!
 //! - Translucent: the material at the point, E(x) by shadow rays (split methods, highlights),
 //!   one cache query, then radiance by the §7 convention, plus an optional Fresnel-weighted
@@ -16,11 +17,13 @@ use lucent_core::{
 };
 
 use super::RenderError;
+use super::adaptive::GroupScratch;
+use super::attributes::SurfaceAttributes;
 use super::prepare::Prepared;
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
 use crate::material::{LocalTerm, Shader, TranslucentShader};
-use crate::raster::{Fragment, VisibilityBuffer, perspective_barycentrics};
+use crate::raster::{Fragment, VisibilityBuffer};
 use crate::sampling::rng::splitmix64;
 
 /// A translucent object's cache and smoothing.
@@ -157,6 +160,8 @@ pub struct PixelScratch {
     pub fragments: Vec<Fragment>,
     /// Shadow-ray hints, kept from pixel to pixel.
     pub shadows: ShadowHints,
+    /// The pixel's shading points (its fragments, split where the shading varies).
+    pub groups: GroupScratch,
 }
 
 /// The read-only state every pixel is shaded from.
@@ -184,8 +189,8 @@ pub struct Shading<'a> {
 }
 
 impl Shading<'_> {
-    /// Shades pixel (x, y). `scratch` is one thread's working memory, best kept along a row
-    /// (its shadow-ray hints); the value does not depend on it.
+    /// Shades pixel (x, y) once per visible object. `scratch` is one thread's working memory,
+    /// best kept along a row (its shadow-ray hints); the value does not depend on it.
     pub fn pixel<S: ShadingStats>(
         &self,
         x: u32,
@@ -194,16 +199,32 @@ impl Shading<'_> {
         stats: &mut S,
     ) -> Result<PixelValue, RenderError> {
         let object_of = &self.prep.object_of;
-        let PixelScratch { fragments, shadows } = scratch;
         self.visibility
-            .resolve(x, y, |t| object_of[t as usize], fragments);
+            .resolve(x, y, |t| object_of[t as usize], &mut scratch.fragments);
+        scratch.groups.whole(&scratch.fragments);
+        self.shade(x, y, scratch, stats)
+    }
+
+    /// Shades pixel (x, y) at the points in `scratch.groups` (from [`Shading::pixel`], or
+    /// split by [`Shading::split_pixel`]), each weighted by its coverage.
+    pub fn shade<S: ShadingStats>(
+        &self,
+        x: u32,
+        y: u32,
+        scratch: &mut PixelScratch,
+        stats: &mut S,
+    ) -> Result<PixelValue, RenderError> {
+        let PixelScratch {
+            shadows, groups, ..
+        } = scratch;
         let mut value = PixelValue::default();
         let aa = self.visibility.aa();
         let per_sample = 1.0 / (aa * aa) as f32;
         let forward = (self.camera.target - self.camera.position).normalize();
         let pixel_index = y as u64 * self.camera.width as u64 + x as u64;
-        for (k, fragment) in fragments.iter().enumerate() {
-            let seed = splitmix64(pixel_index * 16 + k as u64);
+        for group in &groups.groups {
+            let fragment = &group.fragment;
+            let seed = group.seed(splitmix64(pixel_index * 16 + group.source as u64));
             let timed = S::TIMED && self.caches[fragment.key as usize].is_some();
             let start = timed.then(Instant::now);
             let s = self.surface(fragment, seed, shadows, stats)?;
@@ -216,7 +237,7 @@ impl Shading<'_> {
             value.local += s.local * w;
             value.global += s.global * w;
             value.irradiance += s.irradiance * w;
-            if k == 0 {
+            if group.source == 0 && group.part == 0 {
                 value.depth = (s.position - self.camera.position).dot(forward);
             }
         }
@@ -232,27 +253,13 @@ impl Shading<'_> {
     ) -> Result<Surface, RenderError> {
         let prep = self.prep;
         let object = fragment.key as usize;
-        let mesh = &prep.scene.objects[object].mesh;
-        let tri = mesh.triangles[fragment.triangle as usize - prep.first_triangle[object] as usize];
-        let v = tri.map(|i| mesh.positions[i as usize]);
-        let clip = v.map(|p| self.view_proj * p.extend(1.0));
-        let b =
-            perspective_barycentrics(clip, fragment.sample, self.camera.width, self.camera.height)
-                .unwrap_or(Vec3::splat(1.0 / 3.0));
-        let position = v[0] * b.x + v[1] * b.y + v[2] * b.z;
-        let mut normal = (0..3)
-            .fold(Vec3::ZERO, |n, k| n + mesh.normals[tri[k] as usize] * b[k])
-            .normalize_or(Vec3::Z);
-        let uv = mesh.uvs.as_ref().map_or(Vec2::ZERO, |uv| {
-            (0..3).fold(Vec2::ZERO, |t, k| t + uv[tri[k] as usize] * b[k])
-        });
-        let view = (self.camera.position - position).normalize_or(Vec3::Z);
-        let mut geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
-        if geometric.dot(view) < 0.0 {
-            // Seen from behind (open meshes): shade the side the camera sees.
-            normal = -normal;
-            geometric = -geometric;
-        }
+        let SurfaceAttributes {
+            position,
+            normal,
+            geometric,
+            uv,
+            view,
+        } = self.attributes(object, fragment.triangle, fragment.sample);
         let cos_out = outgoing_cosine(normal, geometric, view);
         let mut out = Surface {
             position,
