@@ -1,7 +1,7 @@
 //! The local-integral table of N10 (reference sheet §6b): the noise-free local term's integral
 //!
 //! ```text
-//! K(ℓ_u) = 2π ∫₀^α w(r) Rd_ℓ(r) r dr            (LM07; w the quartic kernel of radius α)
+//! K(ℓ_u) = 2π ∫₀^α w(r) Rd_ℓ(r) r dr            (LM07; w the kernel of radius α, `kernel.rs`)
 //! ```
 //!
 //! cached on demand at ℓ_u = α·2^k — powers of two as N10 prescribes, in units of the smoothing
@@ -89,7 +89,7 @@ pub fn local_integral_unit(dipole: &UnitDipole, a: f64) -> f64 {
 /// a·dK/da, K's derivative in a = α/ℓ_u, by differentiating under the integral:
 ///
 /// ```text
-/// a·dK/da = 2π ∫₀^a (−u w′(u)) Rd_1(ρ) ρ dρ,   u = ρ/a,   −u w′(u) = 4u²(1 − u²)
+/// a·dK/da = 2π ∫₀^a (−u w′(u)) Rd_1(ρ) ρ dρ,   u = ρ/a,   −u w′(u) = 12u⁴(1 − u²)
 /// ```
 ///
 /// (no boundary term: w(1) = 0). It is ≥ 0 (K grows with a, i.e. falls with ℓ), and
@@ -555,11 +555,11 @@ mod tests {
     #[test]
     fn limits_are_reached() {
         let d = UnitDipole::new(0.9, 1.3);
-        // a → ∞: Rd_total. a → 0: π a² Rd_1(0) / 3.
+        // a → ∞: Rd_total. a → 0: Rd_1(0)·2π a² ∫₀¹ w(u) u du = π a² Rd_1(0) / 2.
         let total = crate::dipole::total_reflectance(0.9, 1.3);
         assert!(((local_integral_unit(&d, 1e6) - total) / total).abs() < 1e-6);
         let a = 1e-4;
-        let small = core::f64::consts::PI * a * a * d.rd(0.0) / 3.0;
+        let small = core::f64::consts::PI * a * a * d.rd(0.0) / 2.0;
         assert!(((local_integral_unit(&d, a) - small) / small).abs() < 1e-6);
     }
 
@@ -764,13 +764,19 @@ mod tests {
         for &(albedo, eta) in &[(0.3, 1.0), (0.9, 1.3), (0.999, 1.5)] {
             let d = UnitDipole::new(albedo, eta);
             for &a in &[1.0 / 1024.0, 0.1, 0.7, 1.0, 3.0, 30.0, 1024.0] {
-                let h = 1e-4;
+                // Where K has all but saturated the slope falls like a⁻⁴ and a small step
+                // drowns in K's rounding: a wider step, its O(h²) error allowed.
+                let (h, tolerance) = if a > 100.0 {
+                    (1e-2, 3e-3)
+                } else {
+                    (1e-4, 1e-6)
+                };
                 let fd = (local_integral_unit(&d, a * (1.0 + h))
                     - local_integral_unit(&d, a * (1.0 - h)))
                     / (2.0 * h);
                 let got = local_integral_slope_unit(&d, a);
                 assert!(
-                    got >= 0.0 && (got - fd).abs() <= 1e-6 * fd.abs() + 1e-15,
+                    got >= 0.0 && (got - fd).abs() <= tolerance * fd.abs() + 1e-15,
                     "α′ {albedo} a {a}: {got} vs {fd}"
                 );
             }

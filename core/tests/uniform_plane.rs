@@ -55,16 +55,19 @@ fn every_method_reproduces_e_times_rd_total_on_a_lit_plane() {
             position: x,
             irradiance: e,
         };
-        // The issue requires 1% (every method) and 0.5% (the split methods). Measured: 0.0001%
+        // Required: 1% (every method) and 0.5% (the split methods). Measured: 0.0001%
         // exhaustive, 0.0034% hierarchical (second-order aggregates; 0.39% with JB02's plain
-        // ones), 0.047% local-global and edge-aware. The bounds catch regressions.
+        // ones), local-global and edge-aware 0.056% at k = 1.5 and 0.041% at k = 3, but 0.44%
+        // at k = 1: α is then one grid step, and the kernel's ramp (1 − w is 0.07 at 0.4α and 1
+        // at α) meets the grid's first ring of neighbours at r = α exactly, an
+        // alias a blue-noise set does not have. The bounds catch regressions.
         for (method, tolerance) in [
             (Method::Exhaustive, 0.0001),
             (Method::Hierarchical, 0.0002),
-            (Method::LocalGlobal, 0.002),
-            (Method::EdgeAware, 0.002),
+            (Method::LocalGlobal, 0.001),
+            (Method::EdgeAware, 0.001),
         ] {
-            for k in [1.0, 3.0] {
+            for k in [1.0, 1.5, 3.0] {
                 let alpha = cache.smoothing_radius(k);
                 let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0).unwrap();
                 let settings = QuerySettings {
@@ -82,6 +85,11 @@ fn every_method_reproduces_e_times_rd_total_on_a_lit_plane() {
                     )
                     .unwrap();
                 let err = rel_err(m.total, want);
+                let tolerance = if k == 1.0 && method.is_split() {
+                    0.005
+                } else {
+                    tolerance
+                };
                 assert!(
                     err < tolerance,
                     "{method:?} k {k} at {x}: {} vs {want} ({:.3}%)",

@@ -33,7 +33,7 @@ pub fn exhaustive_sum_lanes<L: Lanes>(cache: &IrradianceCache, profile: &Profile
 }
 
 /// The split sums over every sample in double precision: (Σ (1 − w) Rd E A, Σ w Rd E A,
-/// Σ w Rd A) for the quartic kernel of radius α.
+/// Σ w Rd A) for the kernel of radius α ([`crate::kernel`]).
 fn split_sums(cache: &IrradianceCache, profile: &Profile, x: Vec3, alpha: f32) -> [DVec3; 3] {
     let kernel = Kernel::new(alpha);
     let s = &cache.samples;

@@ -6,11 +6,13 @@
 //! restricted Voronoi diagram ([`voronoi_areas`]): the areas of an object sum to its surface
 //! area, and a sample that stands closer to its neighbours weighs less, so the density
 //! fluctuations of the blue noise and the denser samples near a surface's border do not become
-//! exitance error as they did with equal areas (total / N, as in JB02). Cells are per
+//! exitance error as they did with equal areas (total / N, as in JB02). Each sample then moves
+//! to its cell's centroid (on the surface, with the normal there), so that the sum of area ×
+//! integrand is exact for integrands linear over each cell rather than constant. Cells are per
 //! object (a sample never takes area of another object), and so are the caches: light does not
 //! diffuse from one object into another.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use lucent_core::{IrradianceCache, Sample};
 use rayon::prelude::*;
 
@@ -85,28 +87,47 @@ pub fn place_samples(
             ..Default::default()
         })
         .collect();
+    // Each set's samples as placed: (triangle of the object, barycentrics).
+    let mut placed: Vec<Vec<(u32, Vec2)>> = vec![Vec::new(); sets.len()];
     for p in &points {
         let t = global[p.triangle as usize] as usize;
         let object = prep.object_of[t] as usize;
-        let set = sets
-            .iter_mut()
-            .find(|s| s.object == object)
+        let k = sets
+            .iter()
+            .position(|s| s.object == object)
             .expect("sample on a translucent object");
-        let mesh = &prep.scene.objects[object].mesh;
-        let tri = mesh.triangles[t - prep.first_triangle[object] as usize];
-        let b = [1.0 - p.bary.x - p.bary.y, p.bary.x, p.bary.y];
-        let n = (0..3).fold(Vec3::ZERO, |n, k| n + mesh.normals[tri[k] as usize] * b[k]);
-        set.positions.push(p.position);
-        set.normals.push(n.normalize_or(Vec3::Z));
+        sets[k].positions.push(p.position);
+        placed[k].push((t as u32 - prep.first_triangle[object], p.bary));
+    }
+    drop(points);
+    for (set, placed) in sets.iter_mut().zip(placed) {
+        if set.is_empty() {
+            continue;
+        }
+        let first = prep.first_triangle[set.object] as usize;
+        let last = prep.first_triangle[set.object + 1] as usize;
+        let cells = voronoi_areas(&prep.triangles[first..last], &set.positions);
+        set.areas = cells.areas;
+        let mesh = &prep.scene.objects[set.object].mesh;
+        set.normals.reserve_exact(placed.len());
+        for ((position, c), (triangle, bary)) in
+            set.positions.iter_mut().zip(cells.centroids).zip(placed)
+        {
+            // Every placed sample lies on a triangle with area, so its cell has a centroid;
+            // the sample stays where it was placed otherwise.
+            let (triangle, bary) = if c.triangle == u32::MAX {
+                (triangle, bary)
+            } else {
+                *position = c.position;
+                (c.triangle, c.bary)
+            };
+            let tri = mesh.triangles[triangle as usize];
+            let b = [1.0 - bary.x - bary.y, bary.x, bary.y];
+            let n = (0..3).fold(Vec3::ZERO, |n, k| n + mesh.normals[tri[k] as usize] * b[k]);
+            set.normals.push(n.normalize_or(Vec3::Z));
+        }
     }
     sets.retain(|s| !s.is_empty());
-    for set in &mut sets {
-        let (a, b) = (
-            prep.first_triangle[set.object] as usize,
-            prep.first_triangle[set.object + 1] as usize,
-        );
-        set.areas = voronoi_areas(&prep.triangles[a..b], &set.positions).areas;
-    }
     Ok(sets)
 }
 

@@ -58,6 +58,11 @@ impl Frame {
             v2: DVec2::new(b.dot(e1), b.dot(e2)),
         })
     }
+
+    /// The world position of frame coordinates `(u, v)`.
+    pub(super) fn point(&self, u: f64, v: f64) -> DVec3 {
+        self.origin + self.e1 * u + self.e2 * v
+    }
 }
 
 /// A convex polygon in a triangle's frame with the origin of each edge (see the module
@@ -240,18 +245,29 @@ impl Polygon {
         self.r2
     }
 
-    /// Area (shoelace formula).
-    pub(super) fn area(&self) -> f64 {
+    /// Area and centroid (frame coordinates) of the polygon: the shoelace sums of its
+    /// triangles fanned from its first vertex (so that the sums stay small where the polygon
+    /// is far from the frame's origin). A polygon without area has its first vertex as
+    /// centroid.
+    pub(super) fn moment(&self) -> (f64, DVec2) {
         let n = self.len;
-        if n < 3 {
-            return 0.0;
+        if n == 0 {
+            return (0.0, DVec2::ZERO);
         }
-        let mut twice = 0.0;
-        for k in 0..n {
-            let l = if k + 1 == n { 0 } else { k + 1 };
-            twice += self.u[k] * self.v[l] - self.u[l] * self.v[k];
+        let o = DVec2::new(self.u[0], self.v[0]);
+        let (mut twice, mut first) = (0.0, DVec2::ZERO);
+        for k in 1..n.saturating_sub(1) {
+            let a = DVec2::new(self.u[k], self.v[k]) - o;
+            let b = DVec2::new(self.u[k + 1], self.v[k + 1]) - o;
+            let t = a.perp_dot(b);
+            twice += t;
+            first += (a + b) * t;
         }
-        0.5 * twice.max(0.0)
+        if twice > 0.0 {
+            (0.5 * twice, o + first / (3.0 * twice))
+        } else {
+            (0.0, o)
+        }
     }
 
     /// The neighbours whose bisectors bound the polygon.
@@ -263,50 +279,59 @@ impl Polygon {
     }
 }
 
-/// Squared distance from `p` to the triangle (Ericson, Real-Time Collision Detection §5.1.5),
-/// in `f64`.
-pub(super) fn distance2_to_triangle(p: DVec3, t: &[Vec3; 3]) -> f64 {
+/// The point of triangle `t` nearest to `p`, as barycentric weights of its three vertices
+/// (Ericson, Real-Time Collision Detection §5.1.5), in `f64`; the nearest vertex for a
+/// triangle without area.
+pub(super) fn nearest_on_triangle(p: DVec3, t: &[Vec3; 3]) -> [f64; 3] {
     let (a, b, c) = (t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3());
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
-        return ap.length_squared();
+        return [1.0, 0.0, 0.0];
     }
     let bp = p - b;
     let (d3, d4) = (ab.dot(bp), ac.dot(bp));
     if d3 >= 0.0 && d4 <= d3 {
-        return bp.length_squared();
+        return [0.0, 1.0, 0.0];
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
         let v = d1 / (d1 - d3);
-        return (p - (a + ab * v)).length_squared();
+        return [1.0 - v, v, 0.0];
     }
     let cp = p - c;
     let (d5, d6) = (ab.dot(cp), ac.dot(cp));
     if d6 >= 0.0 && d5 <= d6 {
-        return cp.length_squared();
+        return [0.0, 0.0, 1.0];
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
         let w = d2 / (d2 - d6);
-        return (p - (a + ac * w)).length_squared();
+        return [1.0 - w, 0.0, w];
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (p - (b + (c - b) * w)).length_squared();
+        return [0.0, 1.0 - w, w];
     }
     let denom = va + vb + vc;
     if denom.abs() < f64::MIN_POSITIVE {
-        // Degenerate triangle: the nearest of its vertices.
-        return ap
-            .length_squared()
-            .min(bp.length_squared())
-            .min(cp.length_squared());
+        let d = [ap, bp, cp].map(|x| x.length_squared());
+        let k = (0..3).fold(0, |k, i| if d[i] < d[k] { i } else { k });
+        let mut w = [0.0; 3];
+        w[k] = 1.0;
+        return w;
     }
     let (v, w) = (vb / denom, vc / denom);
-    (p - (a + ab * v + ac * w)).length_squared()
+    [1.0 - v - w, v, w]
+}
+
+/// Squared distance from `p` to triangle `t`, in `f64`.
+pub(super) fn distance2_to_triangle(p: DVec3, t: &[Vec3; 3]) -> f64 {
+    let [_, v, w] = nearest_on_triangle(p, t);
+    let a = t[0].as_dvec3();
+    let q = a + (t[1].as_dvec3() - a) * v + (t[2].as_dvec3() - a) * w;
+    (p - q).length_squared()
 }
 
 #[cfg(test)]
@@ -325,7 +350,9 @@ mod tests {
         let site = DVec3::new(0.5, 0.5, 0.0);
         // Nobody within 10: the whole triangle.
         assert_eq!(p.clip_cell(&f, site, &[], &[], 10.0, 10.0), Outcome::Done);
-        assert!((p.area() - 2.0).abs() < 1e-12);
+        let (a, c) = p.moment();
+        assert!((a - 2.0).abs() < 1e-12);
+        assert!(f.point(c.x, c.y).distance(DVec3::new(2.0, 2.0, 0.0) / 3.0) < 1e-12);
         // A neighbour at (1.5, 0.5), 0.25 above the plane: in the plane its bisector is
         // shifted away from it by the squared height over twice the distance, x = 1 + 0.0625/2.
         let j = DVec3::new(1.5, 0.5, 0.25);
@@ -334,7 +361,16 @@ mod tests {
         assert_eq!(p.clip_cell(&f, site, &sites, &n, 10.0, 10.0), Outcome::Done);
         let x = 1.0 + 0.0625 / 2.0;
         let want = 2.0 - (2.0 - x) * (2.0 - x) / 2.0;
-        assert!((p.area() - want).abs() < 1e-12, "{} vs {want}", p.area());
+        // The centroid: the triangle's less the cut-off corner's (x..2 along the base).
+        let corner = (2.0 - x) * (2.0 - x) / 2.0;
+        let corner_c = DVec3::new((2.0 * x + 2.0) / 3.0, (2.0 - x) / 3.0, 0.0);
+        let want_c = (DVec3::new(2.0, 2.0, 0.0) / 3.0 * 2.0 - corner_c * corner) / want;
+        let (a, c) = p.moment();
+        assert!((a - want).abs() < 1e-12, "{a} vs {want}");
+        assert!(
+            f.point(c.x, c.y).distance(want_c) < 1e-12,
+            "{c} vs {want_c}"
+        );
         assert_eq!(p.bisector_labels().collect::<Vec<_>>(), vec![0]);
         // Without the guarantee, the cell is not proven.
         assert!(matches!(

@@ -9,6 +9,14 @@
 //! neighbours weighs less, so the sum is the integral of the nearest-sample interpolant of the
 //! irradiance: for uniform irradiance it is exact whatever the arrangement.
 //!
+//! Each cell's **centroid** comes with its area ([`VoronoiAreas::centroids`]). A sample moved
+//! there turns the sum Σ A_i·f(x_i) from a rule exact for integrands constant over each cell
+//! into one exact for linear ones (the first moment of the cell about its centroid vanishes),
+//! the midpoint rule of the partition. The partition stays the one of the placed samples: the
+//! moved samples are not the sites of their cells, which the rule does not need. On a curved
+//! mesh the centroid of a cell spanning several triangles lies slightly inside the surface; it
+//! moves to the nearest point of the triangles near the site.
+//!
 //! # Method
 //!
 //! For every site `s` (in parallel over occupied grid cells) and every triangle `t` within
@@ -17,8 +25,9 @@
 //! proves the cell: every unconsidered neighbour is at least twice as far from `s` as the
 //! polygon's farthest vertex, so its bisector cannot cut. Neighbours come from the 3×3×3 cells
 //! around the site's (cells of `CELL` spacings, `cells.rs`); a cell not proven by them is
-//! clipped again with a wider block. The polygons' areas are summed per site in triangle order,
-//! in `f64`: no reduction across threads, the same bits for any thread count.
+//! clipped again with a wider block. The polygons' areas and first moments are summed per site
+//! in triangle order, in `f64`: no reduction across threads, the same bits for any thread
+//! count.
 //!
 //! **Completeness.** A triangle is fully shared out when every bisector edge of every polygon
 //! on it leads to a site that also processed it (the region across that edge belongs to that
@@ -65,12 +74,12 @@ mod tests;
 
 use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::surface::{hex_spacing, triangle_area};
+use super::surface::{SurfacePoint, hex_spacing, triangle_area};
 use cells::Cells;
-use clip::{Frame, Neighbour, Outcome, Polygon, distance2_to_triangle};
+use clip::{Frame, Neighbour, Outcome, Polygon, distance2_to_triangle, nearest_on_triangle};
 
 /// Grid cell edge, in hexagonal-packing spacings. A cell's 3×3×3 block guarantees every
 /// neighbour within one cell edge of its sites, which proves cells whose farthest vertex is
@@ -96,6 +105,11 @@ const INCOMPLETE: u8 = 2;
 pub struct VoronoiAreas {
     /// The area of each site's restricted Voronoi cell (scene units²), in input order.
     pub areas: Vec<f32>,
+    /// Each cell's centroid, on the surface: the nearest point to the centroid of the cell's
+    /// polygons on the triangles near the site (`triangle` indexes the input slice). Where the
+    /// cell lies in one plane that is the centroid itself. A site that takes part in nothing
+    /// (not finite, or no triangle with area) keeps its position, with `triangle` `u32::MAX`.
+    pub centroids: Vec<SurfacePoint>,
     /// Counters.
     pub stats: VoronoiStats,
 }
@@ -122,6 +136,14 @@ pub struct VoronoiStats {
 pub fn voronoi_areas(triangles: &[[Vec3; 3]], sites: &[Vec3]) -> VoronoiAreas {
     let mut out = VoronoiAreas {
         areas: vec![0.0; sites.len()],
+        centroids: sites
+            .iter()
+            .map(|&position| SurfacePoint {
+                position,
+                triangle: u32::MAX,
+                bary: Vec2::ZERO,
+            })
+            .collect(),
         stats: VoronoiStats::default(),
     };
     let live: Vec<bool> = triangles.iter().map(|t| Frame::new(t).is_some()).collect();
@@ -162,13 +184,27 @@ pub fn voronoi_areas(triangles: &[[Vec3; 3]], sites: &[Vec3]) -> VoronoiAreas {
         reach2: reach * reach,
         sorted: SORTED / CELL * size,
     };
-    let (areas, stats) = pass.run();
+    let (cell_sums, stats) = pass.run();
     out.stats = stats;
-    for (&i, &a) in cells.order.iter().zip(&areas) {
+    let centroids = pass.centroids_on_surface(&cell_sums);
+    for ((&i, &(a, _)), c) in cells.order.iter().zip(&cell_sums).zip(centroids) {
         out.stats.empty += (a <= 0.0) as u64;
         out.areas[i as usize] = a.max(f32::MIN_POSITIVE);
+        out.centroids[i as usize] = c;
     }
     out
+}
+
+/// A sorted site's cell: its area and the centroid of its polygons (the site where the area
+/// is 0).
+type CellSum = (f32, Vec3);
+
+/// A polygon the redo pass found for a site the first pass skipped.
+struct Piece {
+    site: u32,
+    triangle: u32,
+    area: f64,
+    centroid: DVec3,
 }
 
 /// One run over an object's sites.
@@ -193,15 +229,15 @@ struct Scratch {
 }
 
 impl Pass<'_> {
-    /// Areas per sorted site, and the counters.
-    fn run(&self) -> (Vec<f32>, VoronoiStats) {
+    /// Area and centroid per sorted site, and the counters.
+    fn run(&self) -> (Vec<CellSum>, VoronoiStats) {
         let cells = self.cells;
         let n = cells.sites.len();
         let flags: Vec<AtomicU8> = (0..self.triangles.len())
             .map(|_| AtomicU8::new(0))
             .collect();
         let (clipped, widened, shared) = (AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0));
-        let mut areas = vec![0.0f32; n];
+        let mut areas: Vec<CellSum> = vec![(0.0, Vec3::ZERO); n];
         // Tasks of CELLS_PER_TASK cells, each with its slice of the output.
         let mut tasks = Vec::new();
         let mut rest = &mut areas[..];
@@ -255,14 +291,20 @@ impl Pass<'_> {
             })
             .collect();
         stats.redone = redo.len() as u64;
-        let extra: Vec<Vec<(u32, u32, f64)>> = redo
+        let extra: Vec<Vec<Piece>> = redo
             .par_iter()
             .map_init(Scratch::default, |scratch, &t| self.redo(t, scratch))
             .collect();
-        let mut extra: Vec<(u32, u32, f64)> = extra.into_iter().flatten().collect();
-        extra.sort_unstable_by_key(|&(s, t, _)| (s, t));
-        for (s, _, a) in extra {
-            areas[s as usize] += a as f32;
+        let mut extra: Vec<Piece> = extra.into_iter().flatten().collect();
+        extra.sort_unstable_by_key(|p| (p.site, p.triangle));
+        for p in extra {
+            let (area, centroid) = &mut areas[p.site as usize];
+            let before = *area as f64;
+            let sum = before + p.area;
+            if sum > 0.0 {
+                *centroid = ((centroid.as_dvec3() * before + p.centroid * p.area) / sum).as_vec3();
+            }
+            *area += p.area as f32;
         }
         if stats.shared > 0 {
             self.share_coincident(&mut areas);
@@ -271,13 +313,13 @@ impl Pass<'_> {
     }
 
     /// The first pass over the sites of occupied cell `c`; `out[k − base]` is sorted site k's
-    /// area. `counts`: pairs clipped, widened, coincident sites.
+    /// area and centroid. `counts`: pairs clipped, widened, coincident sites.
     #[allow(clippy::too_many_arguments)]
     fn cell(
         &self,
         c: usize,
         home: [i64; 3],
-        out: &mut [f32],
+        out: &mut [CellSum],
         base: usize,
         flags: &[AtomicU8],
         scratch: &mut Scratch,
@@ -299,7 +341,8 @@ impl Pass<'_> {
                 &mut scratch.far,
             );
             counts[2] += neighbours.iter().take_while(|n| n.0 == 0.0).count().min(1) as u64;
-            let mut area = 0.0;
+            // Σ a and Σ a·(c − site) over the polygons.
+            let (mut area, mut first) = (0.0, DVec3::ZERO);
             for &t in triangles {
                 let tri = &self.triangles[t as usize];
                 if distance2_to_triangle(ps, tri) > self.reach2 {
@@ -324,8 +367,9 @@ impl Pass<'_> {
                 if outcome != Outcome::Done {
                     continue;
                 }
-                let a = scratch.polygon.area();
+                let (a, c) = scratch.polygon.moment();
                 area += a;
+                first += (frame.point(c.x, c.y) - ps) * a;
                 let mut flag = if a > 0.0 { TOUCHED } else { 0 };
                 if !self.leads_to_processing(&scratch.polygon, tri, self.reach2) {
                     flag |= INCOMPLETE;
@@ -335,7 +379,8 @@ impl Pass<'_> {
                 }
             }
             scratch.neighbours = neighbours;
-            out[s - base] = area as f32;
+            let centroid = if area > 0.0 { ps + first / area } else { ps };
+            out[s - base] = (area as f32, centroid.as_vec3());
         }
     }
 
@@ -436,8 +481,8 @@ impl Pass<'_> {
 
     /// Shares triangle `t` out among every site within 2, 4, 8, … times the reach until the
     /// polygons are proven to tile it; returns the polygons of the sites the first pass did not
-    /// process (site, triangle, area).
-    fn redo(&self, t: u32, scratch: &mut Scratch) -> Vec<(u32, u32, f64)> {
+    /// process.
+    fn redo(&self, t: u32, scratch: &mut Scratch) -> Vec<Piece> {
         let cells = self.cells;
         let tri = &self.triangles[t as usize];
         let Some(frame) = Frame::new(tri) else {
@@ -477,11 +522,16 @@ impl Pass<'_> {
                 if self.clip_wide(s as usize, ps, &frame, 0.0, scratch) != Outcome::Done {
                     continue;
                 }
-                let area = scratch.polygon.area();
+                let (area, c) = scratch.polygon.moment();
                 touched |= area > 0.0;
                 complete &= self.leads_to_processing(&scratch.polygon, tri, reach2);
                 if distance2_to_triangle(ps, tri) > self.reach2 && area > 0.0 {
-                    found.push((s, t, area));
+                    found.push(Piece {
+                        site: s,
+                        triangle: t,
+                        area,
+                        centroid: frame.point(c.x, c.y),
+                    });
                 }
             }
             if (touched && complete) || everyone || !reach2.is_finite() {
@@ -490,9 +540,53 @@ impl Pass<'_> {
         }
     }
 
+    /// Each sorted site's centroid moved to the nearest point of the triangles registered to
+    /// its grid cell (which hold every triangle within the reach of its sites), ties to the
+    /// first; in sorted order.
+    fn centroids_on_surface(&self, sums: &[CellSum]) -> Vec<SurfacePoint> {
+        let cells = self.cells;
+        (0..cells.len())
+            .into_par_iter()
+            .flat_map_iter(|c| {
+                cells.sites_of(c).map(move |s| {
+                    let p = sums[s].1.as_dvec3();
+                    let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0]);
+                    for &t in cells.triangles_of(c) {
+                        let tri = &self.triangles[t as usize];
+                        let w = nearest_on_triangle(p, tri);
+                        let q = tri[0].as_dvec3() * w[0]
+                            + tri[1].as_dvec3() * w[1]
+                            + tri[2].as_dvec3() * w[2];
+                        let d2 = p.distance_squared(q);
+                        if d2 < best.0 {
+                            best = (d2, t, w);
+                        }
+                    }
+                    let (_, triangle, w) = best;
+                    if triangle == u32::MAX {
+                        return SurfacePoint {
+                            position: cells.sites[s],
+                            triangle,
+                            bary: Vec2::ZERO,
+                        };
+                    }
+                    let tri = &self.triangles[triangle as usize];
+                    let position = tri[0].as_dvec3() * w[0]
+                        + tri[1].as_dvec3() * w[1]
+                        + tri[2].as_dvec3() * w[2];
+                    SurfacePoint {
+                        position: position.as_vec3(),
+                        triangle,
+                        bary: Vec2::new(w[1] as f32, w[2] as f32),
+                    }
+                })
+            })
+            .collect()
+    }
+
     /// Divides the area of sites at exactly the same position by their number (each computed
     /// the same whole cell). Coincident sites share a grid cell.
-    fn share_coincident(&self, areas: &mut [f32]) {
+    fn share_coincident(&self, areas: &mut [CellSum]) {
         let cells = self.cells;
         for c in 0..cells.len() {
             let range = cells.sites_of(c);
@@ -501,7 +595,7 @@ impl Pass<'_> {
                     .clone()
                     .filter(|&j| cells.sites[j] == cells.sites[s])
                     .count();
-                areas[s] /= same as f32;
+                areas[s].0 /= same as f32;
             }
         }
     }
