@@ -71,6 +71,7 @@ pub mod presets;
 pub mod profile;
 pub mod quadrature;
 pub mod query;
+pub mod refine;
 pub mod stats;
 pub mod table;
 
@@ -82,5 +83,6 @@ pub use error::{BuildError, ParamError};
 pub use kernel::Kernel;
 pub use profile::{Distance, Profile};
 pub use query::{Exitance, Method, QueryError, QuerySettings, ShadingPoint};
+pub use refine::LocalQuadrature;
 pub use stats::{NoStats, QueryStats, StatsSink};
 pub use table::LocalIntegralTable;

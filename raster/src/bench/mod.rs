@@ -176,7 +176,11 @@ impl BenchConfig {
                 epsilon,
             })
             .collect();
-        for method in [SssMethod::LocalGlobal, SssMethod::EdgeAware] {
+        for method in [
+            SssMethod::LocalGlobal,
+            SssMethod::EdgeAware,
+            SssMethod::EdgeRefined,
+        ] {
             s.push(MethodSetting {
                 method,
                 epsilon: self.split_epsilon,

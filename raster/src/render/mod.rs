@@ -16,6 +16,7 @@ mod convexity;
 pub mod density;
 mod irradiance;
 mod prepare;
+mod refine;
 mod shading;
 
 use std::borrow::Cow;
@@ -185,6 +186,7 @@ pub fn core_method(method: SssMethod) -> Method {
         SssMethod::Hierarchical => Method::Hierarchical,
         SssMethod::LocalGlobal => Method::LocalGlobal,
         SssMethod::EdgeAware => Method::EdgeAware,
+        SssMethod::EdgeRefined => Method::EdgeRefined,
         SssMethod::Exhaustive => Method::Exhaustive,
     }
 }
