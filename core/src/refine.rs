@@ -76,7 +76,7 @@ pub const DEFAULT_PER_RING: usize = 4;
 /// The edge test: the irradiance of the samples within α (summed over the channels) is
 /// uniform when every sample is within this fraction of E(x) (also summed). Beyond it, the
 /// edge-refined method refines the local term.
-pub const EDGE_THRESHOLD: f32 = 0.1;
+pub const EDGE_THRESHOLD: f32 = 0.5;
 
 /// Intervals of the tabulated radial distribution (uniform in √ρ).
 const INTERVALS: usize = 32;

@@ -4,7 +4,8 @@
 //! for each scene (default bunny, sphere, textured ℓ_u):
 //!     ground truth  = local-global, ε_truth, truth_factor × the largest sample count
 //!     convergence   = the same at half the density, compared with the truth
-//!     for each sample count × method (hierarchical at each ε, local-global, edge-aware):
+//!     for each sample count × method (hierarchical at each ε, local-global, edge-aware,
+//!                                        edge-refined):
 //!         render once per seed → median time per phase, nodes per lookup, memory,
 //!         error (translucent pixels, shadow-edge band) against the truth, seed noise
 //!     claim 1:  per count, the three methods at equal ε on one baked sample set, rendered

@@ -49,7 +49,7 @@ pub fn refine(
     m: Exitance,
 ) -> Exitance {
     let (t1, t2) = point.normal.any_orthonormal_pair();
-    let rotation = LocalQuadrature::rotation(splitmix64(point.seed ^ 0x5EED_0F_ED6E));
+    let rotation = LocalQuadrature::rotation(splitmix64(point.seed ^ 0x005E_ED0F_ED6E));
     let mut at = [Vec3::ZERO; lucent_core::refine::MAX_NODES];
     for (n, e) in at.iter_mut().enumerate().take(quadrature.len()) {
         let o = quadrature.offset(n, rotation);
@@ -59,4 +59,47 @@ pub fn refine(
     }
     let local = quadrature.local_term(point.irradiance, point.k, &at[..quadrature.len()]);
     m.with_local(local, point.k)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Light;
+
+    fn marble() -> Profile {
+        Profile::from_preset(lucent_core::presets::find("marble").unwrap(), 20.0).unwrap()
+    }
+
+    /// On a uniformly lit plane every node sees E(x): the refined local term is E·K exactly,
+    /// whatever the rotation; a tilted light gives E·cos θ at every node (the normal at x).
+    #[test]
+    fn a_uniformly_lit_plane_gives_e_times_k_exactly() {
+        let lights = [Light::Directional {
+            direction: Vec3::new(0.6, 0.0, -0.8),
+            color: Vec3::new(1.0, 0.5, 0.25),
+            irradiance: 2.5,
+        }];
+        let lighting = Lighting::new(&lights, None, 10.0);
+        let q = quadrature(&marble(), 0.08);
+        let k = Vec3::new(0.3, 0.25, 0.2);
+        for seed in [0u64, 1, 77, u64::MAX] {
+            let position = Vec3::new(0.3, -1.2, 0.0);
+            let e = lighting.irradiance(position, Vec3::Z, seed);
+            let point = RefinePoint {
+                position,
+                normal: Vec3::Z,
+                irradiance: e,
+                k,
+                seed,
+            };
+            let m = Exitance {
+                global: Vec3::splat(0.5),
+                refine: true,
+                ..Exitance::default()
+            };
+            let r = refine(&lighting, &q, &point, &mut ShadowHints::default(), m);
+            assert_eq!(r.local, e * k);
+            assert_eq!(r.total, e * k + Vec3::splat(0.5));
+        }
+    }
 }
