@@ -338,7 +338,7 @@ fn uniform(range: (f32, f32), e: Vec3, threshold: f32) -> bool {
         return true;
     }
     let ex = e.x + e.y + e.z;
-    lo >= (1.0 - threshold) * ex && hi <= (1.0 + threshold) * ex
+    lo >= (1.0 - threshold) * ex && hi * (1.0 - threshold) <= ex
 }
 
 fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {

@@ -1,6 +1,6 @@
 //! The edge-refined query's edge test against a brute-force oracle: a point is flagged exactly
 //! when some sample within α (of positive area) has an irradiance (summed over the channels)
-//! more than `EDGE_THRESHOLD` away from E(x); unflagged points get edge-aware's result bit for
+//! outside [(1 − τ)·E(x), E(x)/(1 − τ)], τ = `EDGE_THRESHOLD`; unflagged points get edge-aware's result bit for
 //! bit, flagged ones edge-aware's global sum.
 
 use lucent_core::glam::Vec3;
@@ -37,7 +37,7 @@ fn samples() -> Vec<Sample> {
                 0.0,
             );
             let lit = if p.x > 0.0 { 1.0 + 0.1 * p.y } else { 0.0 };
-            let boost = if (i * 60 + j) % 97 == 0 { 1.5 } else { 1.0 };
+            let boost = if (i * 60 + j) % 97 == 0 { 2.5 } else { 1.0 };
             let area = if i == 30 && j == 30 { 0.0 } else { 0.0004 };
             out.push(Sample {
                 position: p,
@@ -80,16 +80,17 @@ fn the_edge_test_matches_brute_force_and_falls_back_to_edge_aware() {
             // Brute force over the samples as the cache stores them (flux / area).
             let ex = e.element_sum();
             let want = samples.iter().any(|s| {
-                (s.position - x).length_squared() < alpha * alpha
-                    && s.area > 0.0
-                    && ((s.irradiance.element_sum() - ex).abs() > EDGE_THRESHOLD * ex * 1.0001
-                        || (ex == 0.0 && s.irradiance.element_sum() > 0.0))
+                (s.position - x).length_squared() < alpha * alpha && s.area > 0.0 && {
+                    let se = s.irradiance.element_sum();
+                    se < (1.0 - EDGE_THRESHOLD) * ex || se * (1.0 - EDGE_THRESHOLD) > ex
+                }
             });
             let near_threshold = samples.iter().any(|s| {
-                (s.position - x).length_squared() < alpha * alpha
-                    && s.area > 0.0
-                    && ((s.irradiance.element_sum() - ex).abs() - EDGE_THRESHOLD * ex).abs()
-                        < 1e-3 * ex
+                (s.position - x).length_squared() < alpha * alpha && s.area > 0.0 && {
+                    let se = s.irradiance.element_sum();
+                    (se - (1.0 - EDGE_THRESHOLD) * ex).abs() < 1e-3 * ex
+                        || (se * (1.0 - EDGE_THRESHOLD) - ex).abs() < 1e-3 * ex
+                }
             });
             if !near_threshold {
                 assert_eq!(refined.refine, want, "x {x}");
