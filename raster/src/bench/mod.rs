@@ -452,7 +452,8 @@ fn run_scene(
             ));
             report.threads = result.threads;
             if count == config.sheet_count {
-                if setting.method != SssMethod::Hierarchical {
+                // The error split compares LM07 and N10 (edge-refined is in its own table).
+                if matches!(setting.method, SssMethod::LocalGlobal | SssMethod::EdgeAware) {
                     split_runs.push((first.stats.samples, first.pixels));
                 }
                 sheet_images.push((setting, first.image));
@@ -725,7 +726,8 @@ mod tests {
                 c.epsilons.contains(&c.split_epsilon),
                 "the overhead claim needs it"
             );
-            assert_eq!(c.settings().len(), c.epsilons.len() + 2);
+            // Hierarchical at each ε, then local-global, edge-aware and edge-refined.
+            assert_eq!(c.settings().len(), c.epsilons.len() + 3);
         }
         assert_eq!(BenchConfig::full().truth_count(), 1_600_000);
     }
