@@ -453,7 +453,10 @@ fn run_scene(
             report.threads = result.threads;
             if count == config.sheet_count {
                 // The error split compares LM07 and N10 (edge-refined is in its own table).
-                if matches!(setting.method, SssMethod::LocalGlobal | SssMethod::EdgeAware) {
+                if matches!(
+                    setting.method,
+                    SssMethod::LocalGlobal | SssMethod::EdgeAware
+                ) {
                     split_runs.push((first.stats.samples, first.pixels));
                 }
                 sheet_images.push((setting, first.image));
