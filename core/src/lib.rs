@@ -6,8 +6,9 @@
 //!   artist parameters or measured presets, with the project's exitance → radiance convention;
 //! - an irradiance cache ([`IrradianceCache`]): a linear octree over Morton-sorted, quantised
 //!   sample positions in flat structure-of-arrays, queried 8 nodes or 8 samples at a time;
-//! - four queries ([`Method`]): hierarchical (Jensen & Buhler 2002), local-global (Langlands &
-//!   Mertens 2007), edge-aware (Neulander 2010) and exhaustive;
+//! - five queries ([`Method`]): hierarchical (Jensen & Buhler 2002), local-global (Langlands &
+//!   Mertens 2007), edge-aware (Neulander 2010), exhaustive, and edge-refined (edge-aware with
+//!   the local term a quadrature of the irradiance at edges, [`refine`]);
 //! - the local-integral table of Neulander 2010 ([`LocalIntegralTable`]), cached at powers of
 //!   two of the mean free path and interpolated, lock-free.
 //!
@@ -71,6 +72,7 @@ pub mod presets;
 pub mod profile;
 pub mod quadrature;
 pub mod query;
+pub mod refine;
 pub mod stats;
 pub mod table;
 
@@ -82,5 +84,6 @@ pub use error::{BuildError, ParamError};
 pub use kernel::Kernel;
 pub use profile::{Distance, Profile};
 pub use query::{Exitance, Method, QueryError, QuerySettings, ShadingPoint};
+pub use refine::LocalQuadrature;
 pub use stats::{NoStats, QueryStats, StatsSink};
 pub use table::LocalIntegralTable;

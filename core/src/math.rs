@@ -31,6 +31,12 @@ pub fn sqrt64(x: f64) -> f64 {
     libm::sqrt(x)
 }
 
+/// (sin x, cos x) in double precision (libm).
+#[inline]
+pub fn sin_cos64(x: f64) -> (f64, f64) {
+    libm::sincos(x)
+}
+
 /// Natural logarithm (libm).
 #[inline]
 pub fn ln(x: f32) -> f32 {

@@ -5,6 +5,7 @@
 //! | [`Method::Hierarchical`] (JB02, §4) | M_o = Σ_cut Rd·E·A |
 //! | [`Method::LocalGlobal`] (LM07, §5) | M_o = E(x)·K + Σ_cut (1 − w)·Rd·E·A |
 //! | [`Method::EdgeAware`] (N10, §6a) | M_o = E_loc·K + Σ_cut (1 − w)·Rd·E·A, E_loc the kernel-weighted cache irradiance with x inserted at r = 0 |
+//! | [`Method::EdgeRefined`] (departure from N10) | as N10 where the irradiance within α is uniform; elsewhere local = ∫ w·Rd·E dA′ by a quadrature of E(x′) that the caller evaluates ([`crate::refine`]) |
 //! | [`Method::Exhaustive`] | M_o = Σ_all Rd·E·A |
 
 use core::fmt;
@@ -16,6 +17,7 @@ use crate::cache::{self, IrradianceCache};
 use crate::kernel::Kernel;
 use crate::lanes::{DefaultLanes, Lanes};
 use crate::profile::Profile;
+use crate::refine::EDGE_THRESHOLD;
 use crate::stats::{NoStats, QueryStats, StatsSink};
 
 /// How a query sums the cache.
@@ -31,15 +33,21 @@ pub enum Method {
     EdgeAware,
     /// Every sample, no approximation.
     Exhaustive,
+    /// N10's traversal and result where the samples' irradiance within α is within
+    /// [`crate::refine::EDGE_THRESHOLD`] of E(x); elsewhere the query flags the point
+    /// ([`Exitance::refine`]) and the caller replaces the local term by a quadrature of the
+    /// irradiance over the α-disc ([`crate::LocalQuadrature`], [`Exitance::with_local`]).
+    EdgeRefined,
 }
 
 impl Method {
     /// All methods, in the order above.
-    pub const ALL: [Method; 4] = [
+    pub const ALL: [Method; 5] = [
         Method::Hierarchical,
         Method::LocalGlobal,
         Method::EdgeAware,
         Method::Exhaustive,
+        Method::EdgeRefined,
     ];
 
     /// The kebab-case name used by the scene format and the command line.
@@ -49,12 +57,16 @@ impl Method {
             Method::LocalGlobal => "local-global",
             Method::EdgeAware => "edge-aware",
             Method::Exhaustive => "exhaustive",
+            Method::EdgeRefined => "edge-refined",
         }
     }
 
-    /// True for the methods with a local term (LM07, N10), which need K and α.
+    /// True for the methods with a local term (LM07, N10, edge-refined), which need K and α.
     pub fn is_split(self) -> bool {
-        matches!(self, Method::LocalGlobal | Method::EdgeAware)
+        matches!(
+            self,
+            Method::LocalGlobal | Method::EdgeAware | Method::EdgeRefined
+        )
     }
 }
 
@@ -103,8 +115,26 @@ pub struct Exitance {
     pub local: Vec3,
     /// The global (octree or exhaustive) sum.
     pub global: Vec3,
-    /// The irradiance that drives the local term: E(x) for LM07, E_loc for N10.
+    /// The irradiance that drives the local term: E(x) for LM07, E_loc for N10 (and for the
+    /// edge-refined method until [`Exitance::with_local`]).
     pub local_irradiance: Vec3,
+    /// Edge-refined only: the samples' irradiance within α is not uniform, so the local term
+    /// should be refined ([`crate::LocalQuadrature::local_term`], [`Exitance::with_local`]).
+    pub refine: bool,
+}
+
+impl Exitance {
+    /// The same result with the local term replaced (the edge-refined method's quadrature):
+    /// total = local + global; `local_irradiance` becomes local / K per channel (0 where K is).
+    pub fn with_local(self, local: Vec3, k: Vec3) -> Exitance {
+        let e = Vec3::select(k.cmpgt(Vec3::ZERO), local / k, Vec3::ZERO);
+        Exitance {
+            total: local + self.global,
+            local,
+            local_irradiance: e,
+            ..self
+        }
+    }
 }
 
 /// An invalid query input.
@@ -251,8 +281,10 @@ impl IrradianceCache {
                 let sums = cache::traverse::<L, S, LOCAL_GLOBAL>(self, profile, x, &params, stats);
                 split_result(sums, e, local_integral)
             }
-            Method::EdgeAware => {
+            Method::EdgeAware | Method::EdgeRefined => {
                 let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
+                let refine = settings.method == Method::EdgeRefined
+                    && !uniform(sums.irradiance_range, e, EDGE_THRESHOLD);
                 // N10: the shading point joins the kernel-weighted average at r = 0 with weight
                 // Rd(0)·Ā, in (1/4, 1] in the traversal's scaled weights (0 if Ā = 0). The
                 // scaled flux sum is Σ w·Rd·E·A·rd_scale·flux_scale: times area_scale /
@@ -267,7 +299,10 @@ impl IrradianceCache {
                 let e_loc = (num / den).as_vec3();
                 // With no weight at all (Ā = 0 and no samples within α) fall back to E(x).
                 let e_loc = Vec3::select(den.cmpgt(DVec3::ZERO) & e_loc.is_finite_mask(), e_loc, e);
-                split_result(sums, e_loc, local_integral)
+                Exitance {
+                    refine,
+                    ..split_result(sums, e_loc, local_integral)
+                }
             }
         };
         Ok(result)
@@ -294,6 +329,18 @@ fn reciprocal_pow2(v: f32) -> f32 {
     crate::math::pow2i((-ceil).clamp(-126, 126))
 }
 
+/// The edge test of the edge-refined method: every sample within α (`range` = min, max of
+/// Σ_c E) within `threshold` of Σ_c E(x) (no samples within α: uniform). A dark x with dark
+/// samples is uniform; a dark x with any lit sample is not.
+fn uniform(range: (f32, f32), e: Vec3, threshold: f32) -> bool {
+    let (lo, hi) = range;
+    if lo > hi {
+        return true;
+    }
+    let ex = e.x + e.y + e.z;
+    lo >= (1.0 - threshold) * ex && hi * (1.0 - threshold) <= ex
+}
+
 fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {
     let local = local_irradiance * k;
     Exitance {
@@ -301,5 +348,6 @@ fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {
         local,
         global: sums.global,
         local_irradiance,
+        refine: false,
     }
 }

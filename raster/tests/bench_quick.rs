@@ -45,13 +45,14 @@ fn quick_bench_writes_a_complete_report() {
         .expect("run lucent");
     assert!(status.success(), "lucent bench --quick failed: {status}");
 
-    // One CSV row per scene × count × method (quick: 2 counts; hierarchical, LM07, N10), and
+    // One CSV row per scene × count × method (quick: 2 counts; hierarchical, LM07, N10,
+    // edge-refined), and
     // per scene LM07 and N10 at the sweep's other smoothing factor (k = 3).
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows.len(), 3 * 2 * 3 + 3 * 2, "{csv}");
+    assert_eq!(rows.len(), 3 * 2 * 4 + 3 * 2, "{csv}");
     let value = |row: &[&str], name: &str| -> f64 {
         row[column(&header, name)]
             .parse()
@@ -115,6 +116,7 @@ fn quick_bench_writes_a_complete_report() {
             "hierarchical_shading_s",
             "local_global_shading_s",
             "edge_aware_shading_s",
+            "edge_refined_shading_s",
         ] {
             assert!(value(name) > 0.0, "{name} in {row:?}");
         }
@@ -122,6 +124,7 @@ fn quick_bench_writes_a_complete_report() {
             "vs_hierarchical",
             "vs_local_global",
             "per_lookup_vs_hierarchical",
+            "refined_vs_edge_aware",
         ] {
             let (lo, mid, hi) = (
                 value(&format!("{ratio}_min")),

@@ -143,6 +143,9 @@ pub(crate) struct Sums {
     pub local_flux: DVec3,
     /// N10: Σ w·Rd·A, scaled by `Params::rd_scale` and `Params::area_scale`.
     pub local_weight: DVec3,
+    /// N10: the range (min, max) of the samples' irradiance E = Σ_c flux / A within α (samples
+    /// of positive area), for the edge-refined method's edge test; (+∞, 0) for none.
+    pub irradiance_range: (f32, f32),
 }
 
 /// For each 8-bit lane mask, its set lanes in increasing order (then zeros).
@@ -243,6 +246,8 @@ struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     global: [L; 3],
     local_flux: [L; 3],
     local_weight: [L; 3],
+    /// N10: lane-wise min and max of the samples' irradiance within α (see `Sums`).
+    range: [L; 2],
     /// The lane sums folded so far, in double precision.
     folded: [[f64; 3]; 3],
     /// Batches evaluated since the last fold.
@@ -322,6 +327,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         // digit. Each factor is scaled on its own, by a power of two (exact, see `Params`):
         // one combined factor 1/(Rd(0)·Ā) overflowed Rd·factor to +∞ where Ā < 2⁻¹²⁷ (∞/∞ =
         // NaN, and E_loc fell back to E(x)).
+        let raw_area = area;
         let area = area.keep(valid) * L::splat(self.area_scale);
         let flux_scale = L::splat(self.flux_scale);
         for c in 0..3 {
@@ -334,6 +340,20 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                 self.local_weight[c] = self.local_weight[c] + weight * area;
             }
         }
+        if MODE == EDGE_AWARE {
+            self.irradiance_range(r2, flux, raw_area, valid);
+        }
+    }
+
+    /// The edge-refined method's edge test: the range of E = Σ_c flux / A over the samples
+    /// within α with positive area (the lanes left out divide by zero, and are masked).
+    #[inline(always)]
+    fn irradiance_range(&mut self, r2: L, flux: [L; 3], area: L, valid: Mask) {
+        let zero = L::splat(0.0);
+        let inside = valid & r2.lt(L::splat(self.kernel.radius2())) & zero.lt(area);
+        let e = ((flux[0] + flux[1] + flux[2]) / area).keep(inside);
+        self.range[0] = self.range[0].min(e + L::splat(f32::MAX).keep(!inside));
+        self.range[1] = self.range[1].max(e);
     }
 
     /// Evaluates the first `n ≤ 8` aggregate terms (all clear of the α-ball: global only).
@@ -648,6 +668,7 @@ pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
         global: zero,
         local_flux: zero,
         local_weight: zero,
+        range: [L::splat(f32::MAX), L::splat(0.0)],
         folded: [[0.0; 3]; 3],
         batches: 0,
         deferred: [0; DEFERRED],
@@ -657,9 +678,15 @@ pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
     walker.run(params);
     walker.fold();
     let [global, local_flux, local_weight] = walker.folded.map(DVec3::from_array);
+    let [lo, hi] = walker.range.map(|r| r.to_array());
+    let lo = lo.into_iter().fold(f32::INFINITY, f32::min);
     Sums {
         global: global.as_vec3(),
         local_flux,
         local_weight,
+        irradiance_range: (
+            if lo == f32::MAX { f32::INFINITY } else { lo },
+            hi.into_iter().fold(0.0, f32::max),
+        ),
     }
 }

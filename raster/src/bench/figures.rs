@@ -2,11 +2,11 @@
 //! shadow-edge band) and a contact sheet laid out like Figure 1 of Neulander 2010.
 //!
 //! ```text
-//!               no smoothing   LM07   edge-aware   ground truth
-//! image            ▢            ▢         ▢             ▢        (inset marked in yellow)
-//! shadow edge ×3   ▢            ▢         ▢             ▢
-//! error            ▢            ▢         ▢                      (relative, log scale,
-//! error ×3         ▢            ▢         ▢                       one white level per sheet)
+//!               no smoothing   LM07   edge-aware   edge-refined   ground truth
+//! image            ▢            ▢         ▢            ▢             ▢     (inset in yellow)
+//! shadow edge ×3   ▢            ▢         ▢            ▢             ▢
+//! error            ▢            ▢         ▢            ▢                   (relative, log
+//! error ×3         ▢            ▢         ▢            ▢                    scale, one white)
 //! ```
 
 use std::path::Path;
@@ -82,14 +82,15 @@ pub fn write_scene_figures(
             })
             .map(|(_, image)| image)
     };
-    let (Some(hier), Some(lm), Some(n10)) = (
+    let (Some(hier), Some(lm), Some(n10), Some(refined)) = (
         pick(SssMethod::Hierarchical),
         pick(SssMethod::LocalGlobal),
         pick(SssMethod::EdgeAware),
+        pick(SssMethod::EdgeRefined),
     ) else {
         return Ok(());
     };
-    let sheet = figure1(config, reference, [hier, lm, n10], exposure)?;
+    let sheet = figure1(config, reference, [hier, lm, n10, refined], exposure)?;
     render_sheet(&sheet)?.write_png(&out.join(format!("{}-figure1.png", scene.name())))?;
     Ok(())
 }
@@ -161,12 +162,12 @@ fn inset(rgb: &[u8], width: u32, height: u32, rect: (u32, u32, u32)) -> Result<T
 fn figure1(
     config: &BenchConfig,
     reference: &Reference,
-    tests: [&RgbImage; 3],
+    tests: [&RgbImage; 4],
     exposure: f32,
 ) -> Result<Sheet, BenchError> {
     let (w, h) = reference.image.size();
     let rect = inset_rect(reference);
-    // One white level for all three error maps: the largest per-pixel relative error.
+    // One white level for all four error maps: the largest per-pixel relative error.
     let mask = Some(reference.translucent.as_slice());
     let mut white = 0.0f32;
     for image in tests {
@@ -217,6 +218,7 @@ fn figure1(
             format!("no smoothing (JB02, eps {})", config.split_epsilon),
             "LM07 (local-global)".to_string(),
             "edge-aware (N10)".to_string(),
+            "edge-refined".to_string(),
             "ground truth".to_string(),
         ],
         rows: vec![

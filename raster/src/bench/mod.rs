@@ -4,7 +4,8 @@
 //! for each scene (default bunny, sphere, textured ℓ_u):
 //!     ground truth  = local-global, ε_truth, truth_factor × the largest sample count
 //!     convergence   = the same at half the density, compared with the truth
-//!     for each sample count × method (hierarchical at each ε, local-global, edge-aware):
+//!     for each sample count × method (hierarchical at each ε, local-global, edge-aware,
+//!                                        edge-refined):
 //!         render once per seed → median time per phase, nodes per lookup, memory,
 //!         error (translucent pixels, shadow-edge band) against the truth, seed noise
 //!     claim 1:  per count, the three methods at equal ε on one baked sample set, rendered
@@ -176,7 +177,11 @@ impl BenchConfig {
                 epsilon,
             })
             .collect();
-        for method in [SssMethod::LocalGlobal, SssMethod::EdgeAware] {
+        for method in [
+            SssMethod::LocalGlobal,
+            SssMethod::EdgeAware,
+            SssMethod::EdgeRefined,
+        ] {
             s.push(MethodSetting {
                 method,
                 epsilon: self.split_epsilon,
@@ -447,7 +452,11 @@ fn run_scene(
             ));
             report.threads = result.threads;
             if count == config.sheet_count {
-                if setting.method != SssMethod::Hierarchical {
+                // The error split compares LM07 and N10 (edge-refined is in its own table).
+                if matches!(
+                    setting.method,
+                    SssMethod::LocalGlobal | SssMethod::EdgeAware
+                ) {
                     split_runs.push((first.stats.samples, first.pixels));
                 }
                 sheet_images.push((setting, first.image));
@@ -720,7 +729,8 @@ mod tests {
                 c.epsilons.contains(&c.split_epsilon),
                 "the overhead claim needs it"
             );
-            assert_eq!(c.settings().len(), c.epsilons.len() + 2);
+            // Hierarchical at each ε, then local-global, edge-aware and edge-refined.
+            assert_eq!(c.settings().len(), c.epsilons.len() + 3);
         }
         assert_eq!(BenchConfig::full().truth_count(), 1_600_000);
     }

@@ -27,7 +27,7 @@ use super::scenes::BenchScene;
 use crate::render::bake;
 use crate::scene::{Scene, SssMethod};
 
-/// The three methods at equal ε, rounds of interleaved renders of one baked sample set.
+/// The split methods and hierarchical at equal ε, rounds of interleaved renders of one baked sample set.
 #[derive(Clone, Debug)]
 pub struct OverheadRow {
     /// The scene.
@@ -36,14 +36,16 @@ pub struct OverheadRow {
     pub samples: u32,
     /// Rounds rendered.
     pub rounds: usize,
-    /// Median shading phase: hierarchical, local-global, edge-aware.
-    pub shading: [Duration; 3],
+    /// Median shading phase: hierarchical, local-global, edge-aware, edge-refined.
+    pub shading: [Duration; 4],
     /// Edge-aware against hierarchical, shading phase: median, min, max over rounds.
     pub vs_hierarchical: Spread,
     /// Edge-aware against local-global, shading phase.
     pub vs_local_global: Spread,
     /// Edge-aware against hierarchical, CPU of the translucent points.
     pub per_lookup_vs_hierarchical: Spread,
+    /// Edge-refined against edge-aware, shading phase (the refinement's cost).
+    pub refined_vs_edge_aware: Spread,
 }
 
 /// A ratio minus one over rounds: the median and the extremes.
@@ -80,10 +82,11 @@ impl Spread {
 }
 
 /// The methods in the order of [`OverheadRow::shading`].
-const METHODS: [SssMethod; 3] = [
+const METHODS: [SssMethod; 4] = [
     SssMethod::Hierarchical,
     SssMethod::LocalGlobal,
     SssMethod::EdgeAware,
+    SssMethod::EdgeRefined,
 ];
 
 /// Measures one scene at `samples` over `rounds` rounds (see the module documentation), at
@@ -101,8 +104,8 @@ pub fn measure(
     }
     let setting = |method| MethodSetting { method, epsilon };
     let baked = bake(&configure(base, setting(METHODS[0]), samples, seed), false)?;
-    let mut shading: [Vec<Duration>; 3] = Default::default();
-    let mut translucent: [Vec<Duration>; 3] = Default::default();
+    let mut shading: [Vec<Duration>; 4] = Default::default();
+    let mut translucent: [Vec<Duration>; 4] = Default::default();
     for round in 0..rounds {
         for k in 0..METHODS.len() {
             let m = (round + k) % METHODS.len();
@@ -112,13 +115,14 @@ pub fn measure(
             translucent[m].push(render.stats.translucent_time.unwrap_or_default());
         }
     }
-    let ratios = |times: &[Vec<Duration>; 3], other: usize| {
+    let ratio = |times: &[Vec<Duration>; 4], this: usize, other: usize| {
         Spread::of(
             (0..rounds)
-                .map(|r| times[2][r].as_secs_f64() / times[other][r].as_secs_f64() - 1.0)
+                .map(|r| times[this][r].as_secs_f64() / times[other][r].as_secs_f64() - 1.0)
                 .collect(),
         )
     };
+    let ratios = |times: &[Vec<Duration>; 4], other: usize| ratio(times, 2, other);
     Ok(OverheadRow {
         scene,
         samples,
@@ -126,6 +130,7 @@ pub fn measure(
         vs_hierarchical: ratios(&shading, 0),
         vs_local_global: ratios(&shading, 1),
         per_lookup_vs_hierarchical: ratios(&translucent, 0),
+        refined_vs_edge_aware: ratio(&shading, 3, 2),
         shading: shading.map(median),
     })
 }
@@ -159,6 +164,7 @@ mod tests {
             row.vs_hierarchical,
             row.vs_local_global,
             row.per_lookup_vs_hierarchical,
+            row.refined_vs_edge_aware,
         ] {
             assert!(s.min <= s.median && s.median <= s.max, "{s:?}");
             assert!(s.min > -1.0 && s.max.is_finite(), "{s:?}");

@@ -242,6 +242,7 @@ fn claims(report: &BenchReport) -> String {
         );
     }
 
+    refined_table(report, &mut s);
     smoothing_sweep(report, &mut s);
     error_split(report, &mut s);
 
@@ -407,6 +408,46 @@ pub fn write_markdown(report: &BenchReport, path: &Path) -> Result<(), BenchErro
     write_file(path, &s)
 }
 
+/// Edge-refined (a departure from N10) against local-global and edge-aware at every count:
+/// the shadow-edge band's error and the shading phase.
+fn refined_table(report: &BenchReport, s: &mut String) {
+    let lm = split(report, SssMethod::LocalGlobal);
+    let n10 = split(report, SssMethod::EdgeAware);
+    let refined = split(report, SssMethod::EdgeRefined);
+    let _ = writeln!(
+        s,
+        "\nEdge-refined (the local term integrated from shadow rays where the irradiance within α is not uniform; `core/src/refine.rs`): mean relative error in the shadow-edge band and overall, and its shading phase against edge-aware's (medians of the seeds).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| scene | samples | edge band: local-global | edge-aware | edge-refined | ratio to local-global | overall: edge-aware | edge-refined | shading vs edge-aware |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for &scene in &report.config.scenes {
+        for &n in &report.config.counts {
+            let (Some(l), Some(e), Some(r)) = (
+                find(report, scene, lm, n),
+                find(report, scene, n10, n),
+                find(report, scene, refined, n),
+            ) else {
+                continue;
+            };
+            let band = |x: &super::RunResult| x.edge_error.map_or(f64::NAN, |x| x.mean_relative_l1);
+            let _ = writeln!(
+                s,
+                "| {} | {n} | {} | {} | {} | {:.2} | {} | {} | {:+.1}% |",
+                scene.name(),
+                pct(band(l)),
+                pct(band(e)),
+                pct(band(r)),
+                band(r) / band(l),
+                pct(e.error.mean_relative_l1),
+                pct(r.error.mean_relative_l1),
+                (r.timings.shading.as_secs_f64() / e.timings.shading.as_secs_f64() - 1.0) * 100.0
+            );
+        }
+    }
+}
+
 /// Claim 1 from the interleaved rounds (`overhead.rs`), with the medians over scenes.
 fn overhead_table(report: &BenchReport, s: &mut String) {
     if report.overhead.is_empty() {
@@ -414,12 +455,12 @@ fn overhead_table(report: &BenchReport, s: &mut String) {
     }
     let _ = writeln!(
         s,
-        "\nThe same claim measured on its own, robust to the machine's load: per scene and count the three methods render one baked sample set in {} interleaved rounds (the order rotating), and each round gives its own ratios; the table lists their median and range (`raster/src/bench/overhead.rs`).\n",
+        "\nThe same claim measured on its own, robust to the machine's load: per scene and count the four methods render one baked sample set in {} interleaved rounds (the order rotating), and each round gives its own ratios; the table lists their median and range (`raster/src/bench/overhead.rs`).\n",
         report.config.overhead_rounds
     );
     let _ = writeln!(
         s,
-        "| scene | samples | hierarchical | local-global | edge-aware | vs hierarchical | vs local-global | per lookup vs hierarchical |\n|---|---:|---:|---:|---:|---:|---:|---:|"
+        "| scene | samples | hierarchical | local-global | edge-aware | edge-refined | vs hierarchical | vs local-global | per lookup vs hierarchical | edge-refined vs edge-aware |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     let spread = |x: super::Spread| {
         format!(
@@ -433,20 +474,22 @@ fn overhead_table(report: &BenchReport, s: &mut String) {
         let ms = row.shading.map(|t| t.as_secs_f64() * 1e3);
         let _ = writeln!(
             s,
-            "| {} | {} | {:.1} ms | {:.1} ms | {:.1} ms | {} | {} | {} |",
+            "| {} | {} | {:.1} ms | {:.1} ms | {:.1} ms | {:.1} ms | {} | {} | {} | {} |",
             row.scene.name(),
             row.samples,
             ms[0],
             ms[1],
             ms[2],
+            ms[3],
             spread(row.vs_hierarchical),
             spread(row.vs_local_global),
-            spread(row.per_lookup_vs_hierarchical)
+            spread(row.per_lookup_vs_hierarchical),
+            spread(row.refined_vs_edge_aware)
         );
     }
     let _ = writeln!(
         s,
-        "\n| scene | median over counts: vs hierarchical | per lookup vs hierarchical | vs local-global |\n|---|---:|---:|---:|"
+        "\n| scene | median over counts: vs hierarchical | per lookup vs hierarchical | vs local-global | edge-refined vs edge-aware |\n|---|---:|---:|---:|---:|"
     );
     for &scene in &report.config.scenes {
         let rows: Vec<_> = report
@@ -462,27 +505,28 @@ fn overhead_table(report: &BenchReport, s: &mut String) {
         };
         let _ = writeln!(
             s,
-            "| {} | {:+.1}% | {:+.1}% | {:+.1}% |",
+            "| {} | {:+.1}% | {:+.1}% | {:+.1}% | {:+.1}% |",
             scene.name(),
             med(|r| r.vs_hierarchical.median),
             med(|r| r.per_lookup_vs_hierarchical.median),
-            med(|r| r.vs_local_global.median)
+            med(|r| r.vs_local_global.median),
+            med(|r| r.refined_vs_edge_aware.median)
         );
     }
 }
 
 /// The header of `overhead.csv` (one row per scene and count follows).
-pub const OVERHEAD_CSV_HEADER: &str = "scene,samples_requested,rounds,hierarchical_shading_s,local_global_shading_s,edge_aware_shading_s,vs_hierarchical_median,vs_hierarchical_min,vs_hierarchical_max,vs_local_global_median,vs_local_global_min,vs_local_global_max,per_lookup_vs_hierarchical_median,per_lookup_vs_hierarchical_min,per_lookup_vs_hierarchical_max";
+pub const OVERHEAD_CSV_HEADER: &str = "scene,samples_requested,rounds,hierarchical_shading_s,local_global_shading_s,edge_aware_shading_s,edge_refined_shading_s,vs_hierarchical_median,vs_hierarchical_min,vs_hierarchical_max,vs_local_global_median,vs_local_global_min,vs_local_global_max,per_lookup_vs_hierarchical_median,per_lookup_vs_hierarchical_min,per_lookup_vs_hierarchical_max,refined_vs_edge_aware_median,refined_vs_edge_aware_min,refined_vs_edge_aware_max";
 
 /// Writes `overhead.csv`: claim 1's interleaved measurement (ratios minus one).
 pub fn write_overhead_csv(report: &BenchReport, path: &Path) -> Result<(), BenchError> {
     let mut s = String::new();
     let _ = writeln!(s, "{OVERHEAD_CSV_HEADER}");
     for r in &report.overhead {
-        let [h, l, e] = r.shading.map(|t| t.as_secs_f64());
+        let [h, l, e, f] = r.shading.map(|t| t.as_secs_f64());
         let _ = write!(
             s,
-            "{},{},{},{h},{l},{e}",
+            "{},{},{},{h},{l},{e},{f}",
             r.scene.name(),
             r.samples,
             r.rounds
@@ -491,6 +535,7 @@ pub fn write_overhead_csv(report: &BenchReport, path: &Path) -> Result<(), Bench
             r.vs_hierarchical,
             r.vs_local_global,
             r.per_lookup_vs_hierarchical,
+            r.refined_vs_edge_aware,
         ] {
             let _ = write!(s, ",{},{},{}", x.median, x.min, x.max);
         }

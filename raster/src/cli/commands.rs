@@ -101,6 +101,7 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
             MethodArg::Hierarchical => SssMethod::Hierarchical,
             MethodArg::LocalGlobal => SssMethod::LocalGlobal,
             MethodArg::EdgeAware => SssMethod::EdgeAware,
+            MethodArg::EdgeRefined => SssMethod::EdgeRefined,
             MethodArg::Exhaustive => SssMethod::Exhaustive,
         };
     }

@@ -60,6 +60,9 @@ pub enum MethodArg {
     LocalGlobal,
     /// Neulander 2010: local term from a kernel-weighted cache query (soft shadow edges).
     EdgeAware,
+    /// Edge-aware, with the local term integrated from shadow rays where the irradiance
+    /// within the smoothing radius is not uniform (sharper, faithful shadow edges).
+    EdgeRefined,
     /// Every sample, no approximation (slow; the reference).
     Exhaustive,
 }

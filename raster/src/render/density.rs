@@ -196,7 +196,7 @@ impl DensityPlan {
             SssMethod::Hierarchical | SssMethod::Exhaustive => format!(
                 "{name} will show blotches (bright spots at the samples, dark between them)"
             ),
-            SssMethod::LocalGlobal | SssMethod::EdgeAware => {
+            SssMethod::LocalGlobal | SssMethod::EdgeAware | SssMethod::EdgeRefined => {
                 let alpha = smoothing * (self.area / f64::from(self.count.max(1))).sqrt() as f32;
                 format!(
                     "{name} will render hard, stair-stepped shadow edges (its smoothing radius \

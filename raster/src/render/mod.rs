@@ -21,6 +21,7 @@ mod convexity;
 pub mod density;
 mod irradiance;
 mod prepare;
+mod edge_refined;
 mod refine;
 mod shading;
 
@@ -207,6 +208,7 @@ pub fn core_method(method: SssMethod) -> Method {
         SssMethod::Hierarchical => Method::Hierarchical,
         SssMethod::LocalGlobal => Method::LocalGlobal,
         SssMethod::EdgeAware => Method::EdgeAware,
+        SssMethod::EdgeRefined => Method::EdgeRefined,
         SssMethod::Exhaustive => Method::Exhaustive,
     }
 }

@@ -13,13 +13,15 @@ use glam::{Mat4, Vec2, Vec3};
 use lucent_core::lanes::DefaultLanes;
 use lucent_core::table::exact_local_integral;
 use lucent_core::{
-    IrradianceCache, NoStats, QuerySettings, QueryStats, ShadingPoint, StatsSink, fresnel,
+    IrradianceCache, LocalQuadrature, NoStats, QuerySettings, QueryStats, ShadingPoint, StatsSink,
+    fresnel,
 };
 
 use super::RenderError;
 use super::adaptive::GroupScratch;
 use super::attributes::SurfaceAttributes;
 use super::prepare::Prepared;
+use super::edge_refined::{self, RefinePoint};
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
 use crate::material::{LocalTerm, Shader, TranslucentShader};
@@ -39,6 +41,9 @@ pub struct ObjectCache {
     /// ([`LocalTerm::exact`]), so it carries no table interpolation error and costs no
     /// lookup at the shading points (a table lookup cost about 6% of a lookup on the sphere).
     pub uniform_k: Option<Vec3>,
+    /// The edge-refined quadrature when the material does not vary (textured materials build
+    /// theirs at each refined point).
+    pub quadrature: Option<LocalQuadrature>,
 }
 
 impl ObjectCache {
@@ -50,20 +55,24 @@ impl ObjectCache {
         local: Option<LocalTerm>,
         shader: Option<&TranslucentShader>,
     ) -> Result<ObjectCache, RenderError> {
-        let uniform_k = match (&local, shader) {
+        let (uniform_k, quadrature) = match (&local, shader) {
             (Some(term), Some(shader)) if !shader.is_textured() => {
                 let point = shader.at(Vec2::ZERO).map_err(|e| {
                     RenderError::Material(format!("material '{}': {e}", shader.name))
                 })?;
-                Some(term.exact(&point))
+                (
+                    Some(term.exact(&point)),
+                    Some(edge_refined::quadrature(&point.profile, alpha)),
+                )
             }
-            _ => None,
+            _ => (None, None),
         };
         Ok(ObjectCache {
             cache,
             alpha,
             local,
             uniform_k,
+            quadrature,
         })
     }
 }
@@ -323,6 +332,21 @@ impl Shading<'_> {
                         stats,
                     )
                     .map_err(|err| RenderError::Core(format!("query at {position}: {err}")))?;
+                let m = if m.refine {
+                    let q = oc
+                        .quadrature
+                        .unwrap_or_else(|| edge_refined::quadrature(&point.profile, oc.alpha));
+                    let at = RefinePoint {
+                        position,
+                        normal,
+                        irradiance: e,
+                        k,
+                        seed,
+                    };
+                    edge_refined::refine(&lighting, &q, &at, shadows, m)
+                } else {
+                    m
+                };
                 out.exitance = m.total;
                 out.local = m.local;
                 out.global = m.global;

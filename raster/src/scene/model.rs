@@ -223,6 +223,10 @@ pub enum SssMethod {
     /// query (soft, faithful shadow edges). The default.
     #[default]
     EdgeAware,
+    /// Edge-aware, with the local term a quadrature of the irradiance over the smoothing disc
+    /// (shadow rays at fixed nodes) wherever the irradiance within it is not uniform (a
+    /// departure from Neulander 2010; `lucent_core::refine`).
+    EdgeRefined,
     /// Every sample, no approximation (the reference).
     Exhaustive,
 }

@@ -29,10 +29,11 @@ pub const MAX_SAMPLES: i64 = 1 << 25;
 pub const AUTO: &str = "auto";
 
 /// Values accepted by `render.method`.
-pub const METHODS: [(&str, SssMethod); 4] = [
+pub const METHODS: [(&str, SssMethod); 5] = [
     ("hierarchical", SssMethod::Hierarchical),
     ("local-global", SssMethod::LocalGlobal),
     ("edge-aware", SssMethod::EdgeAware),
+    ("edge-refined", SssMethod::EdgeRefined),
     ("exhaustive", SssMethod::Exhaustive),
 ];
 
