@@ -19,9 +19,9 @@ mod attributes;
 mod baked;
 mod convexity;
 pub mod density;
+mod edge_refined;
 mod irradiance;
 mod prepare;
-mod edge_refined;
 mod refine;
 mod shading;
 

@@ -20,8 +20,8 @@ use lucent_core::{
 use super::RenderError;
 use super::adaptive::GroupScratch;
 use super::attributes::SurfaceAttributes;
-use super::prepare::Prepared;
 use super::edge_refined::{self, RefinePoint};
+use super::prepare::Prepared;
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
 use crate::material::{LocalTerm, Shader, TranslucentShader};
