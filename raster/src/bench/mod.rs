@@ -543,7 +543,7 @@ fn run_scene(
 /// sphere at 23k the global term errs by 2.1% of the band's exitance, the local term by 1.6%
 /// for local-global and 0.8% for edge-aware). A larger α moves work from
 /// the noisy global sum to the local term: local-global's edge then hardens (N10's Figure 1
-/// and the reference sheet §5), edge-aware's does not.
+/// and `docs/physics.md` §12), edge-aware's does not.
 fn smoothing_sweep(
     config: &BenchConfig,
     scene: BenchScene,
