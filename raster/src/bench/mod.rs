@@ -16,7 +16,7 @@
 //! report: report.md, results.csv, overhead.csv, <scene>-error-vs-time.png, <scene>-figure1.png
 //! ```
 //!
-//! **Ground truth.** The issue asks for the exhaustive sum over a sample set much denser
+//! **Ground truth.** The natural truth is the exhaustive sum over a sample set much denser
 //! than the test sets. At 16 × 100k samples that is 1.6 M profile evaluations per pixel —
 //! hours on two cores — and a point sum without smoothing converges slowly anyway: each
 //! pixel's value is dominated by the few samples nearest to it (Rd peaks at r = 0), so
