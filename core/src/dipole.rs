@@ -308,7 +308,7 @@ impl Dipole {
     /// Rd at the centroid alone; see `cache/traverse.rs`), on eight lanes.
     ///
     /// Let v = P − x be the centroid offset (r = |v|), δ = p − P a point of the node about its
-    /// centroid, C = E[δδᵀ] the node's flux-weighted covariance and M₄ = E[δ⊗δ⊗δ⊗δ] its fourth
+    /// centroid, C = E\[δδᵀ\] the node's flux-weighted covariance and M₄ = E\[δ⊗δ⊗δ⊗δ\] its fourth
     /// moment. Per source, the term is a function of s = ½|v + δ|² alone, F(s) with
     /// d² = 2s + z², and the Taylor expansion of the mean about P is
     ///

@@ -21,7 +21,7 @@
 //! `max_samples` defaults to half the memory the system reports available (Linux:
 //! `MemAvailable` in `/proc/meminfo`) at [`PEAK_BYTES_PER_SAMPLE`] each, or
 //! [`FALLBACK_MAX_SAMPLES`] where that is unknown, never more than the hard limit
-//! [`MAX_SAMPLES`](crate::scene::MAX_SAMPLES) = 2²⁵.
+//! [`MAX_SAMPLES`] = 2²⁵.
 //!
 //! Whatever chose the count (auto with its cap, an explicit count or spacing, a baked set), a
 //! spacing above [`WARN_SPACING`] · ℓ_d,min gets one warning ([`DensityPlan::warning`]): the
