@@ -1,5 +1,6 @@
 //! The classical dipole diffusion profile of Jensen, Marschner, Levoy & Hanrahan 2001 (J01,
-//! eq. 4), one colour channel, evaluated from the *squared* distance r².
+//! eq. 4), one colour channel, evaluated from the *squared* distance r² (`docs/physics.md`
+//! §2; the fourth-order cluster aggregate: §10).
 //!
 //! ```text
 //! Rd(r) = α′/(4π) · [ z_r (σ_tr d_r + 1) e^(−σ_tr d_r) / d_r³ + z_v (σ_tr d_v + 1) e^(−σ_tr d_v) / d_v³ ]

@@ -1,5 +1,6 @@
 //! The edge-refined local term: a deterministic quadrature of the irradiance itself over the
-//! smoothing disc, where the irradiance within α is not uniform (a departure from N10).
+//! smoothing disc, where the irradiance within α is not uniform (a departure from N10;
+//! `docs/physics.md` §16).
 //!
 //! Every split method computes M_o = local + Σ_cut (1 − w)·Rd·E·A, and the exact local term is
 //!

@@ -1,6 +1,6 @@
 //! How many irradiance samples a render places: the automatic count (`samples = "auto"`, the
 //! default), the memory-sized cap on it, and the warning when the samples are too far apart
-//! for the material.
+//! for the material (`docs/physics.md` §7).
 //!
 //! The dipole profile (Jensen et al. 2001) falls off as e^(−σ_tr·r)/r², so the
 //! distance that matters is the **diffuse mean free path ℓ_d = 1/σ_tr**. One Poisson-disk set
