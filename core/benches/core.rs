@@ -198,8 +198,9 @@ fn run_queries<L: Lanes>(b: Bencher, method: Method, epsilon: f32) {
 }
 
 /// Queries per second per method at 23k samples (cull tolerance 1e-4, k 1.5), at ε from 0.05
-/// (pbrt-v2's default) to 2 (about the 0.6% image error of the C++ reference of issue 4 with
-/// lucent's second-order aggregates; its fourth-order ones are more accurate still).
+/// (pbrt-v2's default) to 2 (about the 0.6% image error of the C++ reference that `lucent
+/// bench` compares with, `REFERENCE_ERROR` in `raster/src/bench/report.rs`, with lucent's
+/// second-order aggregates; its fourth-order ones are more accurate still).
 #[divan::bench(types = [ScalarLanes, SimdLanes], args = [0.05, 0.4, 1.0, 2.0])]
 fn query_hierarchical<L: Lanes>(b: Bencher, epsilon: f32) {
     run_queries::<L>(b, Method::Hierarchical, epsilon);

@@ -1,5 +1,6 @@
 //! The classical dipole diffusion profile of Jensen, Marschner, Levoy & Hanrahan 2001 (J01,
-//! eq. 4), one colour channel, evaluated from the *squared* distance r².
+//! eq. 4), one colour channel, evaluated from the *squared* distance r² (`docs/physics.md`
+//! §2; the fourth-order cluster aggregate: §10).
 //!
 //! ```text
 //! Rd(r) = α′/(4π) · [ z_r (σ_tr d_r + 1) e^(−σ_tr d_r) / d_r³ + z_v (σ_tr d_v + 1) e^(−σ_tr d_v) / d_v³ ]
@@ -26,7 +27,7 @@ pub fn boundary_term(eta: f64) -> f64 {
 }
 
 /// Total diffuse reflectance ∫ Rd dA of a semi-infinite medium in closed form (J01 eq. 5 as
-/// quoted on the reference sheet §1):
+/// written in `docs/physics.md` §2):
 /// Rd_total(α′) = (α′/2)(1 + e^(−(4/3) A √(3(1−α′)))) e^(−√(3(1−α′))).
 /// Monotone increasing on [0, 1], from 0 to 1.
 pub fn total_reflectance(albedo: f64, eta: f64) -> f64 {
@@ -181,7 +182,7 @@ impl Dipole {
     }
 
     /// From the reduced albedo α′ ∈ (0, 1) and the reduced extinction σ_t′ = 1/ℓ_u (per scene
-    /// unit). The scaling law of the reference sheet: for fixed α′ and η every length of the
+    /// unit). The scaling law (`docs/physics.md` §2): for fixed α′ and η every length of the
     /// profile is proportional to ℓ_u.
     pub fn from_albedo_and_extinction(
         albedo: f64,
@@ -308,7 +309,7 @@ impl Dipole {
     /// Rd at the centroid alone; see `cache/traverse.rs`), on eight lanes.
     ///
     /// Let v = P − x be the centroid offset (r = |v|), δ = p − P a point of the node about its
-    /// centroid, C = E[δδᵀ] the node's flux-weighted covariance and M₄ = E[δ⊗δ⊗δ⊗δ] its fourth
+    /// centroid, C = E\[δδᵀ\] the node's flux-weighted covariance and M₄ = E\[δ⊗δ⊗δ⊗δ\] its fourth
     /// moment. Per source, the term is a function of s = ½|v + δ|² alone, F(s) with
     /// d² = 2s + z², and the Taylor expansion of the mean about P is
     ///
@@ -486,7 +487,7 @@ mod tests {
     use crate::quadrature::GaussLegendre;
     use alloc::vec::Vec;
 
-    /// Whole milk, red channel (reference sheet §1): σ_s′ = 2.55, σ_a = 0.0011 per mm, η 1.3.
+    /// Whole milk, red channel (`docs/physics.md` §2): σ_s′ = 2.55, σ_a = 0.0011 per mm, η 1.3.
     fn milk_red() -> Dipole {
         Dipole::from_coefficients(0.0011, 2.55, 1.3).unwrap()
     }
@@ -598,7 +599,7 @@ mod tests {
 
     #[test]
     fn total_reflectance_matches_reference_materials() {
-        // Reference sheet §3: Skin1 0.44 0.23 0.13; Wholemilk 0.91 0.88 0.76 (η 1.3);
+        // docs/physics.md §4: Skin1 0.44 0.23 0.13; Wholemilk 0.91 0.88 0.76 (η 1.3);
         // Marble 0.83 0.79 0.75 (η 1.5).
         /// (σ_s′, σ_a, η, expected Rd_total) per material.
         type Case = ([f32; 3], [f32; 3], f32, [f32; 3]);

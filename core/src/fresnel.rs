@@ -1,4 +1,5 @@
-//! Fresnel terms at a smooth dielectric boundary (reference sheet §1 and §7).
+//! Fresnel terms at a smooth dielectric boundary (`docs/physics.md` §3; §17 for
+//! their use in the exitance → radiance conversion).
 //!
 //! η is always the relative index inside / outside (1.3 skin, 1.5 marble).
 
@@ -54,7 +55,7 @@ pub fn diffuse_reflectance_exact(eta: f64) -> f64 {
 }
 
 /// pbrt-v2's polynomial fit of the external diffuse reflectance, evaluated at x = 1/η
-/// (reference sheet §1). Kept to cross-check [`diffuse_reflectance_exact`].
+/// (`docs/physics.md` §3). Kept to cross-check [`diffuse_reflectance_exact`].
 pub fn diffuse_reflectance_external_fit(eta: f64) -> f64 {
     let x = 1.0 / eta;
     -0.4399 + 0.7099 / x - 0.3319 / (x * x) + 0.0636 / (x * x * x)
@@ -64,7 +65,7 @@ pub fn diffuse_reflectance_external_fit(eta: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// Reference values from the reference sheet §1 (exact hemispherical integrals).
+    /// Reference values from `docs/physics.md` §3 (exact hemispherical integrals).
     const EXTERNAL: [(f64, f64); 5] = [
         (1.2, 0.0443),
         (1.3, 0.0611),

@@ -1,4 +1,4 @@
-//! The smoothing kernel w(r) of the local/global split (LM07, N10).
+//! The smoothing kernel w(r) of the local/global split (LM07, N10; `docs/physics.md` §11).
 //!
 //! LM07 does not publish its kernel; it only needs w(0) = 1, w(r ≥ α) = 0 and smoothness in
 //! between. lucent uses the smoothstep of t = 1 − r²/α²:

@@ -1,5 +1,5 @@
 //! Measured materials of Jensen et al. 2001 (J01, Figure 5), as carried by pbrt; coefficients in
-//! mm⁻¹ (reference sheet §3). Use with [`crate::Profile::from_preset`] and a unit scale.
+//! mm⁻¹ (`docs/physics.md` §4). Use with [`crate::Profile::from_preset`] and a unit scale.
 
 /// One measured material.
 #[derive(Clone, Copy, Debug, PartialEq)]

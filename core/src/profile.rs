@@ -1,7 +1,7 @@
 //! The RGB diffusion profile of a material: three [`Dipole`] channels sharing one η, built from
 //! coefficients, from artist parameters (K_d with a distance, JB02 §4) or from a measured
-//! preset; plus the conversion from exitance to radiance (the project's convention, reference
-//! sheet §7).
+//! preset; plus the conversion from exitance to radiance (the project's convention,
+//! `docs/physics.md` §17).
 
 use glam::Vec3;
 
@@ -19,7 +19,7 @@ pub const KD_MIN: f32 = 1e-5;
 pub const KD_MAX: f32 = 1.0 - 1e-5;
 
 /// Which mean free path a distance is. Both conventions are common and confused in public
-/// docs (reference sheet §2), so the API names them apart.
+/// docs (`docs/physics.md` §1), so the API names them apart.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Distance {
     /// ℓ_u = 1/σ_t′, the mean free path: N10's ℓ_u, pbrt-v3's `mfp`.
@@ -33,7 +33,7 @@ pub enum Distance {
 pub struct Profile {
     channels: [Dipole; 3],
     eta: f32,
-    /// 1 / (π (1 − F_dr,ext(η))), the exitance → radiance factor of §7.
+    /// 1 / (π (1 − F_dr,ext(η))), the exitance → radiance factor (`docs/physics.md` §17).
     radiance_scale: f32,
 }
 
@@ -92,7 +92,7 @@ impl Profile {
         ))
     }
 
-    /// From artist parameters (JB02 §4 reparameterisation, reference sheet §2): the total
+    /// From artist parameters (JB02 §4 reparameterisation, `docs/physics.md` §4): the total
     /// diffuse reflectance K_d per channel (in (0, 1), clamped to [`KD_MIN`, `KD_MAX`]) and a
     /// distance. α′ = Rd_total⁻¹(K_d); then σ_t′ = 1/ℓ_u, or σ_t′ = σ_tr/√(3(1−α′)) with
     /// σ_tr = 1/ℓ_d.
@@ -255,8 +255,8 @@ impl Profile {
         Vec3::from(self.channels.map(|d| d.sigma_s_prime()))
     }
 
-    /// Outgoing radiance from radiant exitance M_o, the project's convention (reference sheet
-    /// §7): L_o = F_t(η, cos θ_o) / (π (1 − F_dr,ext(η))) · M_o. Integrating L_o cos θ over the
+    /// Outgoing radiance from radiant exitance M_o, the project's convention
+    /// (`docs/physics.md` §17): L_o = F_t(η, cos θ_o) / (π (1 − F_dr,ext(η))) · M_o. Integrating L_o cos θ over the
     /// hemisphere gives back M_o exactly, so a flat uniformly lit surface of albedo K_d has
     /// radiant exitance E·K_d.
     pub fn radiance(&self, exitance: Vec3, cos_out: f32) -> Vec3 {

@@ -1,5 +1,6 @@
 //! Gauss–Legendre quadrature in double precision, for the integrals the core precomputes
-//! (the local-integral table, the external diffuse Fresnel reflectance).
+//! (the local-integral table, the external diffuse Fresnel reflectance; `docs/physics.md`
+//! §15).
 //!
 //! The nodes are computed at construction by Newton's method on the Legendre polynomial
 //! P_N (Golub & Welsch would also do; Newton is simpler and exact to rounding for N ≤ 64), so

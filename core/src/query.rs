@@ -1,12 +1,12 @@
 //! The public query API: which method, its settings, and what a query returns.
 //!
-//! | method | formula (reference sheet) |
+//! | method | formula (`docs/physics.md`) |
 //! |---|---|
-//! | [`Method::Hierarchical`] (JB02, §4) | M_o = Σ_cut Rd·E·A |
-//! | [`Method::LocalGlobal`] (LM07, §5) | M_o = E(x)·K + Σ_cut (1 − w)·Rd·E·A |
-//! | [`Method::EdgeAware`] (N10, §6a) | M_o = E_loc·K + Σ_cut (1 − w)·Rd·E·A, E_loc the kernel-weighted cache irradiance with x inserted at r = 0 |
-//! | [`Method::EdgeRefined`] (departure from N10) | as N10 where the irradiance within α is uniform; elsewhere local = ∫ w·Rd·E dA′ by a quadrature of E(x′) that the caller evaluates ([`crate::refine`]) |
-//! | [`Method::Exhaustive`] | M_o = Σ_all Rd·E·A |
+//! | [`Method::Hierarchical`] (JB02, §9) | M_o = Σ_cut Rd·E·A |
+//! | [`Method::LocalGlobal`] (LM07, §12) | M_o = E(x)·K + Σ_cut (1 − w)·Rd·E·A |
+//! | [`Method::EdgeAware`] (N10, §13) | M_o = E_loc·K + Σ_cut (1 − w)·Rd·E·A, E_loc the kernel-weighted cache irradiance with x inserted at r = 0 |
+//! | [`Method::EdgeRefined`] (departure from N10, §16) | as N10 where the irradiance within α is uniform; elsewhere local = ∫ w·Rd·E dA′ by a quadrature of E(x′) that the caller evaluates ([`crate::refine`]) |
+//! | [`Method::Exhaustive`] (§9) | M_o = Σ_all Rd·E·A |
 
 use core::fmt;
 

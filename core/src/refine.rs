@@ -1,10 +1,11 @@
 //! The edge-refined local term: a deterministic quadrature of the irradiance itself over the
-//! smoothing disc, where the irradiance within α is not uniform (a departure from N10).
+//! smoothing disc, where the irradiance within α is not uniform (a departure from N10;
+//! `docs/physics.md` §16).
 //!
 //! Every split method computes M_o = local + Σ_cut (1 − w)·Rd·E·A, and the exact local term is
 //!
 //! ```text
-//! local(x) = ∫_{|x′ − x| < α} w(|x′ − x|) · Rd(|x′ − x|) · E(x′) dA′     (LM07; w quartic)
+//! local(x) = ∫_{|x′ − x| < α} w(|x′ − x|) · Rd(|x′ − x|) · E(x′) dA′     (LM07; w of docs/physics.md §11)
 //! ```
 //!
 //! LM07 takes E(x′) ≈ E(x) (local = E(x)·K, a hard step at a shadow edge); N10 takes the

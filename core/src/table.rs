@@ -1,4 +1,4 @@
-//! The local-integral table of N10 (reference sheet §6b): the noise-free local term's integral
+//! The local-integral table of N10 (`docs/physics.md` §14): the noise-free local term's integral
 //!
 //! ```text
 //! K(ℓ_u) = 2π ∫₀^α w(r) Rd_ℓ(r) r dr            (LM07; w the kernel of radius α, `kernel.rs`)
@@ -27,7 +27,7 @@
 //! ℓ/α = 2^−0.5). In the ℓ⁻² tail ln K is linear in log ℓ, which the cubic reproduces.
 //!
 //! By the scaling law Rd_ℓ(r) = Rd_1(r/ℓ)/ℓ², K depends only on a = α/ℓ (for fixed α′, η):
-//! K = 2π ∫₀^a w(ρ/a) Rd_1(ρ) ρ dρ. It rises from ≈ π a² Rd_1(0)/3 for a → 0 (ℓ ≫ α) to
+//! K = 2π ∫₀^a w(ρ/a) Rd_1(ρ) ρ dρ. It rises from ≈ π a² Rd_1(0)/2 for a → 0 (ℓ ≫ α) to
 //! Rd_total(α′) for a → ∞ (ℓ → 0, the Lambertian limit).
 //!
 //! ```text

@@ -1,4 +1,5 @@
-//! Light sources and the irradiance they deliver to a surface point, with shadow rays.
+//! Light sources and the irradiance they deliver to a surface point, with shadow rays
+//! (`docs/physics.md` §5).
 //!
 //! Units: point, spot and sphere lights have a radiant intensity I (W/sr, times `color`), so an
 //! unoccluded surface at distance d facing the light receives E = I/d²; a directional light

@@ -1,4 +1,4 @@
-//! Bad input to the `lucent` binary (issue 5, "Bad input"): malformed and truncated TOML,
+//! Bad input to the `lucent` binary: malformed and truncated TOML,
 //! OBJ, PNG and PLY files; missing files; textures of the wrong format or size; resolutions
 //! of 0 and 100000²; NaN in any number; bad flags; unwritable outputs.
 //!

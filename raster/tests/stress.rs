@@ -1,4 +1,4 @@
-//! Numerical stress at the renderer level (issue 5, "Numerical stress"): whole scenes at
+//! Numerical stress at the renderer level: whole scenes at
 //! scales 1e-4 … 1e4, tiny and huge translucent objects side by side, mean free paths down
 //! to the ℓ → 0 limit. Every pixel of every render must be finite and non-negative; where
 //! the physics promises more (scale invariance, E·Rd_total on a lit plane), that is checked

@@ -64,8 +64,8 @@ pub fn exhaustive_local_global(
     (irradiance.as_dvec3() * local_integral.as_dvec3() + global).as_vec3()
 }
 
-/// The N10 estimate with every sample evaluated, scalar, double-precision sums (reference
-/// sheet §6a): E_loc = [Rd(0) Ā E(x) + Σ w Rd A E] / [Rd(0) Ā + Σ w Rd A], then
+/// The N10 estimate with every sample evaluated, scalar, double-precision sums
+/// (`docs/physics.md` §13): E_loc = [Rd(0) Ā E(x) + Σ w Rd A E] / [Rd(0) Ā + Σ w Rd A], then
 /// M_o = E_loc·K + Σ (1 − w) Rd E A.
 pub fn exhaustive_edge_aware(
     cache: &IrradianceCache,

@@ -1,5 +1,5 @@
 //! The one traversal behind the hierarchical (JB02), local-global (LM07) and edge-aware (N10)
-//! queries, eight nodes or eight samples per step.
+//! queries, eight nodes or eight samples per step (the equations: `docs/physics.md` §9–§13).
 //!
 //! A stack holds internal nodes whose children are still to be examined. Popping a node
 //! examines all its children at once in 8 lanes:

@@ -16,7 +16,7 @@
 //! report: report.md, results.csv, overhead.csv, <scene>-error-vs-time.png, <scene>-figure1.png
 //! ```
 //!
-//! **Ground truth.** The issue asks for the exhaustive sum over a sample set much denser
+//! **Ground truth.** The natural truth is the exhaustive sum over a sample set much denser
 //! than the test sets. At 16 × 100k samples that is 1.6 M profile evaluations per pixel —
 //! hours on two cores — and a point sum without smoothing converges slowly anyway: each
 //! pixel's value is dominated by the few samples nearest to it (Rd peaks at r = 0), so
@@ -543,7 +543,7 @@ fn run_scene(
 /// sphere at 23k the global term errs by 2.1% of the band's exitance, the local term by 1.6%
 /// for local-global and 0.8% for edge-aware). A larger α moves work from
 /// the noisy global sum to the local term: local-global's edge then hardens (N10's Figure 1
-/// and the reference sheet §5), edge-aware's does not.
+/// and `docs/physics.md` §12), edge-aware's does not.
 fn smoothing_sweep(
     config: &BenchConfig,
     scene: BenchScene,

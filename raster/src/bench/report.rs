@@ -11,7 +11,7 @@ use crate::output::{OutputError, write_atomically};
 use crate::scene::SssMethod;
 
 /// The well-known C++ implementation's CPU per lookup on the sphere (µs) and its error
-/// against its own exhaustive sum (relative), as quoted in the issue.
+/// against its own exhaustive sum (relative): the figures claim 4 compares with.
 pub const REFERENCE_US_PER_LOOKUP: f64 = 26.0;
 /// See [`REFERENCE_US_PER_LOOKUP`].
 pub const REFERENCE_ERROR: f64 = 0.006;
@@ -60,7 +60,7 @@ fn smoothing_sweep(report: &BenchReport, s: &mut String) {
     }
     let _ = writeln!(
         s,
-        "\nThe same at {} samples for several smoothing radii α = k·√Ā (the reference sheet allows k ≈ 1–3; every other run uses the scene's k, 1.5). A larger α hands more of the sum to the noise-free local term: local-global's edge hardens, edge-aware's does not.\n\n| scene | k | edge band: local-global | edge-aware | ratio | overall: local-global | edge-aware | noise: local-global | edge-aware |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "\nThe same at {} samples for several smoothing radii α = k·√Ā (`docs/physics.md` §12: k ≈ 1–3; every other run uses the scene's k, 1.5). A larger α hands more of the sum to the noise-free local term: local-global's edge hardens, edge-aware's does not.\n\n| scene | k | edge band: local-global | edge-aware | ratio | overall: local-global | edge-aware | noise: local-global | edge-aware |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|",
         report.config.sheet_count
     );
     let band = |r: &RunResult| r.edge_error.map_or(f64::NAN, |e| e.mean_relative_l1);

@@ -3,7 +3,7 @@
 //! | name | what | shadow edge |
 //! |---|---|---|
 //! | `default` | the built-in default scene: marble bunny, plate, key and fill light | across the bunny |
-//! | `sphere` | `scenes/sphere-shadow.toml`: the marble sphere of the issue (radius 1 cm at (0, 0, 1), plate edge in x = 0) | the great circle x = 0 |
+//! | `sphere` | `scenes/sphere-shadow.toml`: a marble sphere (radius 1 cm at (0, 0, 1), plate edge in x = 0) | the great circle x = 0 |
 //! | `textured` | `scenes/textured-mfp.toml`: a slab whose ℓ_u spans two decades (texture) | the line y = 0, across the ramp |
 
 use std::borrow::Cow;

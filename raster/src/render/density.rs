@@ -1,6 +1,6 @@
 //! How many irradiance samples a render places: the automatic count (`samples = "auto"`, the
 //! default), the memory-sized cap on it, and the warning when the samples are too far apart
-//! for the material.
+//! for the material (`docs/physics.md` §7).
 //!
 //! The dipole profile (Jensen et al. 2001) falls off as e^(−σ_tr·r)/r², so the
 //! distance that matters is the **diffuse mean free path ℓ_d = 1/σ_tr**. One Poisson-disk set
@@ -21,7 +21,7 @@
 //! `max_samples` defaults to half the memory the system reports available (Linux:
 //! `MemAvailable` in `/proc/meminfo`) at [`PEAK_BYTES_PER_SAMPLE`] each, or
 //! [`FALLBACK_MAX_SAMPLES`] where that is unknown, never more than the hard limit
-//! [`MAX_SAMPLES`](crate::scene::MAX_SAMPLES) = 2²⁵.
+//! [`MAX_SAMPLES`] = 2²⁵.
 //!
 //! Whatever chose the count (auto with its cap, an explicit count or spacing, a baked set), a
 //! spacing above [`WARN_SPACING`] · ℓ_d,min gets one warning ([`DensityPlan::warning`]): the

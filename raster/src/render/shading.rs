@@ -3,7 +3,8 @@
 //! material ([`super::adaptive`]), each weighted by its coverage.
 //!
 //! - Translucent: the material at the point, E(x) by shadow rays (split methods, highlights),
-//!   one cache query, then radiance by the §7 convention, plus an optional Fresnel-weighted
+//!   one cache query, then radiance by the convention of
+//!   `docs/physics.md` §17, plus an optional Fresnel-weighted
 //!   normalised Blinn–Phong highlight.
 //! - Lambert: L = albedo / π · E(x).
 

@@ -2,7 +2,7 @@
 //! loading (shared between materials that name the same file).
 //!
 //! A translucent material is given in exactly one of three ways (see `docs/scene-format.md`
-//! and the project's physics reference §2): a measured preset of Jensen et al. 2001 with the
+//! and `docs/physics.md` §4): a measured preset of Jensen et al. 2001 with the
 //! scene's scale, explicit coefficients, or the artist parameters of Jensen & Buhler 2002
 //! (diffuse reflectance K_d and one named mean free path).
 

@@ -2,8 +2,8 @@
 //!
 //! A [`Sandbox`] is a fresh directory holding a small valid scene (`scene.toml`, 32 × 32
 //! pixels, 500 samples, writing `out.png` and `out.exr`) and both output files pre-filled with
-//! known bytes. [`Sandbox::fails`] runs the binary there and asserts the three promises of
-//! issue 5 at once: the expected exit code, a message on stderr naming the problem, and the
+//! known bytes. [`Sandbox::fails`] runs the binary there and asserts the three promises made
+//! for bad input at once: the expected exit code, a message on stderr naming the problem, and the
 //! directory byte-for-byte as it was (no output written or overwritten, no temporary file
 //! left behind).
 
