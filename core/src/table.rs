@@ -20,11 +20,12 @@
 //!
 //! | interpolation | linear in ℓ | in 1/ℓ | in 1/ℓ² | log K vs log ℓ | Hermite in log K vs log ℓ (used) |
 //! |---|---|---|---|---|---|
-//! | max. relative error | 41% | 12.5% | 10.5% | 5.2% | 0.075% |
+//! | max. relative error | 41% | 12.5% | 10.5% | 5.2% | 0.095% |
 //!
 //! Linear in ℓ fails where K ∝ ℓ⁻² (ℓ ≫ α); every variant peaks near ℓ ≈ 0.7 α, where the
-//! kernel's edge cuts into the profile (the Hermite's worst case: K_d 0.05, η 1.5,
-//! ℓ/α = 2^−0.5). In the ℓ⁻² tail ln K is linear in log ℓ, which the cubic reproduces.
+//! kernel's edge cuts into the profile (the Hermite's worst case: K_d 0.05, η 1.4,
+//! ℓ/α = 2^−0.5; the other columns were measured with the quartic kernel). In the ℓ⁻² tail
+//! ln K is linear in log ℓ, which the cubic reproduces.
 //!
 //! By the scaling law Rd_ℓ(r) = Rd_1(r/ℓ)/ℓ², K depends only on a = α/ℓ (for fixed α′, η):
 //! K = 2π ∫₀^a w(ρ/a) Rd_1(ρ) ρ dρ. It rises from ≈ π a² Rd_1(0)/2 for a → 0 (ℓ ≫ α) to
@@ -750,7 +751,8 @@ mod tests {
         }
         let (e, kd, eta, x) = worst;
         std::println!("worst relative interpolation error {e:e} (K_d {kd} η {eta} ℓ/α 2^{x})");
-        // Measured: 7.5e-4 (K_d 0.05, η 1.5, ℓ/α = 2^−0.5); log–log linear had 5.2%.
+        // Measured: 9.5e-4 (K_d 0.05, η 1.4, ℓ/α = 2^−0.5; 7.5e-4 with the quartic kernel);
+        // log–log linear had 5.2%.
         assert!(
             e < 1e-3,
             "worst relative interpolation error {e} (K_d {kd} η {eta} ℓ/α 2^{x})"
