@@ -157,7 +157,7 @@ pub fn poisson_samples_with_progress(
         .map(|c| count_tiles(&layout, |emit| chunk(c, &mut |_, p| emit(p))))
         .collect();
     advance();
-    let tiles = Tiles::build(layout, &counts, chunk);
+    let mut tiles = Tiles::build(layout, &counts, chunk);
     drop(counts);
     advance();
 
@@ -198,6 +198,9 @@ pub fn poisson_samples_with_progress(
                     eliminate(&tiles, t, keep, d_max, &kernel, scratch);
                 });
             advance();
+        }
+        if round + 1 < SCHEDULE.len() {
+            tiles.compact();
         }
     }
 
