@@ -246,6 +246,7 @@ impl Tiles {
         // Second pass: every slot is written exactly once, by the chunk that owns it, so
         // relaxed atomic stores (plain moves on x86) make the scatter safe and deterministic.
         let scatter: Vec<[AtomicU32; 4]> = (0..total)
+            .into_par_iter()
             .map(|_| [const { AtomicU32::new(0) }; 4])
             .collect();
         offsets.par_iter().enumerate().for_each(|(c, chunk)| {
@@ -322,7 +323,7 @@ impl Tiles {
             }
         }
         tile_cells.push(cell_key.len() as u32);
-        let index: Vec<u32> = slots.iter().map(|c| c.index).collect();
+        let index: Vec<u32> = slots.par_iter().map(|c| c.index).collect();
         // Reuses the allocation again: every weight starts at zero.
         let slots: Vec<Slot> = slots
             .into_iter()

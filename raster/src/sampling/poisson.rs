@@ -65,6 +65,8 @@
 //! samples); recomputing the weights at every round instead of writing back the halo's cost
 //! 25% more time.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -205,13 +207,25 @@ pub fn poisson_samples_with_progress(
     }
 
     // 4. The survivors, regenerated from their streams.
-    let mut keep = vec![0u64; blocks * BLOCK / 64];
-    for (slot, &i) in tiles.slots.iter().zip(&tiles.index) {
-        if !slot.removed() {
-            keep[i as usize / 64] |= 1 << (i % 64);
-        }
-    }
+    // A bitmap by candidate index, set in parallel: OR is commutative, so the bits do not
+    // depend on the order of the stores.
+    let keep: Vec<AtomicU64> = (0..blocks * BLOCK / 64)
+        .into_par_iter()
+        .map(|_| AtomicU64::new(0))
+        .collect();
+    tiles
+        .slots
+        .par_chunks(1 << 16)
+        .zip(tiles.index.par_chunks(1 << 16))
+        .for_each(|(slots, index)| {
+            for (slot, &i) in slots.iter().zip(index) {
+                if !slot.removed() {
+                    keep[i as usize / 64].fetch_or(1 << (i % 64), Ordering::Relaxed);
+                }
+            }
+        });
     drop(tiles);
+    let keep: Vec<u64> = keep.into_iter().map(AtomicU64::into_inner).collect();
     let per_block: Vec<usize> = keep
         .chunks(BLOCK / 64)
         .map(|w| w.iter().map(|x| x.count_ones() as usize).sum())
