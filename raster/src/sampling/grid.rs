@@ -13,7 +13,13 @@
 //! tile_cells: [ 0, 83, 170, ... ]                        first cell of each tile (+ end)
 //! cell_key:   [ (x·8 + y)·8 + z, ... ]                   the cell within its tile (u16)
 //! cell_start: [ 0, 6, 11, ... ]                          first slot of each cell
+//! cell_end:   [ 4, 9, 15, ... ]                          one past its last live slot
 //! ```
+//!
+//! [`Tiles::compact`] moves each cell's live candidates to the front of its slots between
+//! rounds of the elimination (order kept, the rest marked removed), so a gather reads only
+//! live ones: a round removes about a fifth of them, so without it the removed slots pile up
+//! and the gathers read nearly twice as many slots over the rounds.
 //!
 //! [`Tiles::gather`] copies one tile's candidates and those of the adjacent cells of its 26
 //! neighbour tiles (the halo) into a [`Neighbourhood`]: a dense block of `(8 + 2)³` cells in
@@ -774,5 +780,93 @@ mod tests {
             owned,
             (0..pts.len() as u32).filter(|&s| !skipped(s)).count()
         );
+    }
+
+    /// Compaction leaves every gather the same points, in the same order, with the same
+    /// weights and positions, and the same set of live candidate indices, round after round.
+    #[test]
+    fn compaction_keeps_every_gather() {
+        let mut rng = Pcg32::new(4, 7);
+        let pts: Vec<Vec3> = (0..5000)
+            .map(|_| {
+                Vec3::new(
+                    rng.next_f32() * 3.0,
+                    rng.next_f32() * 3.0,
+                    rng.next_f32() * 0.5,
+                )
+            })
+            .collect();
+        let layout = Layout::new(Vec3::ZERO, 0.17);
+        let chunk = |_: usize, emit: &mut dyn FnMut(u32, Vec3)| {
+            for (i, &p) in pts.iter().enumerate() {
+                emit(i as u32, p);
+            }
+        };
+        let counts = vec![count_tiles(&layout, |emit| chunk(0, &mut |_, p| emit(p)))];
+        let mut tiles = Tiles::build(layout, &counts, chunk);
+        assert!(tiles.len() > 8);
+        let snapshot = |tiles: &Tiles| {
+            let mut near = Neighbourhood::default();
+            let mut all = Vec::new();
+            for t in 0..tiles.len() {
+                tiles.gather(t, 0.5, &mut near);
+                let moved: Vec<(Vec3, u32)> = near
+                    .slot
+                    .iter()
+                    .map(|&s| (tiles.slots[s as usize].position, tiles.index[s as usize]))
+                    .collect();
+                all.push((
+                    near.x.clone(),
+                    near.y.clone(),
+                    near.z.clone(),
+                    near.w.clone(),
+                    near.cell.clone(),
+                    near.own.clone(),
+                    moved,
+                ));
+            }
+            let mut live: Vec<u32> = tiles
+                .slots
+                .iter()
+                .zip(&tiles.index)
+                .filter(|(s, _)| !s.removed())
+                .map(|(_, &i)| i)
+                .collect();
+            live.sort_unstable();
+            (all, live)
+        };
+        for (s, slot) in tiles.slots.iter().enumerate() {
+            slot.set_weight(s as f32);
+        }
+        for round in 0..3u32 {
+            // Remove about a third of what is left, at random.
+            for slot in &tiles.slots {
+                if !slot.removed() && rng.next_below(3) == 0 {
+                    slot.set_weight(f32::NEG_INFINITY);
+                }
+            }
+            let before = snapshot(&tiles);
+            tiles.compact();
+            let after = snapshot(&tiles);
+            assert!(before.1.len() < pts.len(), "round {round}");
+            assert_eq!(before.1, after.1, "live set, round {round}");
+            assert_eq!(before.0, after.0, "gathers, round {round}");
+            // Each cell's live slots are at its front, the rest of its slots removed.
+            for (c, (&a, &b)) in tiles.cell_start.iter().zip(&tiles.cell_end).enumerate() {
+                let next = tiles
+                    .cell_start
+                    .get(c + 1)
+                    .copied()
+                    .unwrap_or(tiles.slots.len() as u32);
+                assert!(a <= b && b <= next, "cell {c}");
+                for s in a..next {
+                    assert_eq!(
+                        tiles.slots[s as usize].removed(),
+                        s >= b,
+                        "cell {c}, slot {s}"
+                    );
+                }
+            }
+        }
     }
 }
