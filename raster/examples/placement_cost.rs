@@ -56,6 +56,13 @@ fn main() {
         let points = poisson_samples(tris, SampleTarget::Count(n), 1).expect("samples");
         let (e_wall, e_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
         let sites: Vec<_> = points.iter().map(|p| p.position).collect();
+        // FNV-1a over the positions' bits: equal output across builds and thread counts.
+        let hash = sites
+            .iter()
+            .flat_map(|p| p.to_array())
+            .fold(0xcbf2_9ce4_8422_2325u64, |h, v| {
+                (h ^ v.to_bits() as u64).wrapping_mul(0x0100_0000_01b3)
+            });
         drop(points);
         let (t, c) = (Instant::now(), cpu_seconds());
         let areas = voronoi_areas(tris, &sites);
@@ -63,7 +70,7 @@ fn main() {
         assert_eq!(areas.areas.len(), n as usize);
         println!(
             "run {run}: elimination {e_wall:.3} s wall, {e_cpu:.2} s CPU; voronoi {v_wall:.3} s \
-             wall, {v_cpu:.2} s CPU"
+             wall, {v_cpu:.2} s CPU; samples {hash:016x}"
         );
         ew.push(e_wall);
         ec.push(e_cpu);

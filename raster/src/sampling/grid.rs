@@ -13,7 +13,13 @@
 //! tile_cells: [ 0, 83, 170, ... ]                        first cell of each tile (+ end)
 //! cell_key:   [ (x·8 + y)·8 + z, ... ]                   the cell within its tile (u16)
 //! cell_start: [ 0, 6, 11, ... ]                          first slot of each cell
+//! cell_end:   [ 4, 9, 15, ... ]                          one past its last live slot
 //! ```
+//!
+//! [`Tiles::compact`] moves each cell's live candidates to the front of its slots between
+//! rounds of the elimination (order kept, the rest marked removed), so a gather reads only
+//! live ones: a round removes about a fifth of them, so without it the removed slots pile up
+//! and the gathers read nearly twice as many slots over the rounds.
 //!
 //! [`Tiles::gather`] copies one tile's candidates and those of the adjacent cells of its 26
 //! neighbour tiles (the halo) into a [`Neighbourhood`]: a dense block of `(8 + 2)³` cells in
@@ -195,6 +201,9 @@ pub(super) struct Tiles {
     tile_cells: Vec<u32>,
     cell_key: Vec<u16>,
     cell_start: Vec<u32>,
+    /// One past the last live slot of each cell: [`Tiles::compact`] moves each cell's live
+    /// candidates to its front, so a gather reads only those.
+    cell_end: Vec<u32>,
     /// The candidates, tile by tile and cell by cell.
     pub(super) slots: Vec<Slot>,
     /// Each slot's candidate index in generation order.
@@ -243,6 +252,7 @@ impl Tiles {
         // Second pass: every slot is written exactly once, by the chunk that owns it, so
         // relaxed atomic stores (plain moves on x86) make the scatter safe and deterministic.
         let scatter: Vec<[AtomicU32; 4]> = (0..total)
+            .into_par_iter()
             .map(|_| [const { AtomicU32::new(0) }; 4])
             .collect();
         offsets.par_iter().enumerate().for_each(|(c, chunk)| {
@@ -308,13 +318,18 @@ impl Tiles {
         let mut tile_cells = Vec::with_capacity(keys.len() + 1);
         let count: usize = cells.iter().map(Vec::len).sum();
         let (mut cell_key, mut cell_start) = (Vec::with_capacity(count), Vec::with_capacity(count));
-        for c in &cells {
+        let mut cell_end = Vec::with_capacity(count);
+        for (t, c) in cells.iter().enumerate() {
             tile_cells.push(cell_key.len() as u32);
             cell_key.extend(c.iter().map(|&(k, _)| k));
             cell_start.extend(c.iter().map(|&(_, s)| s));
+            cell_end.extend(c.iter().skip(1).map(|&(_, s)| s));
+            if !c.is_empty() {
+                cell_end.push(tile_start[t + 1]);
+            }
         }
         tile_cells.push(cell_key.len() as u32);
-        let index: Vec<u32> = slots.iter().map(|c| c.index).collect();
+        let index: Vec<u32> = slots.par_iter().map(|c| c.index).collect();
         // Reuses the allocation again: every weight starts at zero.
         let slots: Vec<Slot> = slots
             .into_iter()
@@ -355,6 +370,7 @@ impl Tiles {
             tile_cells,
             cell_key,
             cell_start,
+            cell_end,
             slots,
             index,
         }
@@ -376,6 +392,50 @@ impl Tiles {
     pub(super) fn colour(&self, t: usize) -> usize {
         let c = unpack(self.keys[t]);
         ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) as usize
+    }
+
+    /// Moves the live candidates of every cell to the front of its slots (keeping their
+    /// order), marks the vacated slots removed and shortens the cell, so that later gathers
+    /// read only live candidates. Gathers see the same candidates in the same order as before.
+    pub(super) fn compact(&mut self) {
+        let mut parts = Vec::with_capacity(self.len());
+        let (mut slots, mut index, mut ends) = (
+            &mut self.slots[..],
+            &mut self.index[..],
+            &mut self.cell_end[..],
+        );
+        for t in 0..self.keys.len() {
+            let n = (self.tile_start[t + 1] - self.tile_start[t]) as usize;
+            let cells = (self.tile_cells[t + 1] - self.tile_cells[t]) as usize;
+            let (s, s_rest) = std::mem::take(&mut slots).split_at_mut(n);
+            let (i, i_rest) = std::mem::take(&mut index).split_at_mut(n);
+            let (e, e_rest) = std::mem::take(&mut ends).split_at_mut(cells);
+            let first_cell = self.tile_cells[t] as usize;
+            let starts = &self.cell_start[first_cell..first_cell + cells];
+            parts.push((self.tile_start[t], s, i, e, starts));
+            (slots, index, ends) = (s_rest, i_rest, e_rest);
+        }
+        parts
+            .into_par_iter()
+            .for_each(|(base, slots, index, ends, starts)| {
+                for (end, &start) in ends.iter_mut().zip(starts) {
+                    let (a, b) = ((start - base) as usize, (*end - base) as usize);
+                    let mut k = a;
+                    for j in a..b {
+                        let w = *slots[j].weight.get_mut();
+                        if w != REMOVED {
+                            slots[k].position = slots[j].position;
+                            *slots[k].weight.get_mut() = w;
+                            index[k] = index[j];
+                            k += 1;
+                        }
+                    }
+                    for slot in &mut slots[k..b] {
+                        *slot.weight.get_mut() = REMOVED;
+                    }
+                    *end = base + k as u32;
+                }
+            });
     }
 
     /// Copies tile `t`'s candidates and its halo into `out`, with their weights, leaving out
@@ -420,12 +480,7 @@ impl Tiles {
                     let mut add = |c: usize| {
                         let key = keys[c] as i64;
                         if let Some(l) = local(key as u16, [dx, dy, dz]) {
-                            let a = self.cell_start[first + c];
-                            let b = if first + c + 1 < last {
-                                self.cell_start[first + c + 1]
-                            } else {
-                                self.tile_start[u as usize + 1]
-                            };
+                            let (a, b) = (self.cell_start[first + c], self.cell_end[first + c]);
                             out.runs.push((l as u32, a, b, own));
                         }
                     };
@@ -448,28 +503,31 @@ impl Tiles {
 
         let corner = self.layout.tile_corner(self.keys[t]);
         let inv = 1.0 / unit as f64;
-        out.clear();
+        // Written without a branch on removal (a coin flip in the middle rounds): every slot
+        // is copied, and the write position advances only past live ones.
+        let total: usize = out.runs.iter().map(|r| (r.2 - r.1) as usize).sum();
+        out.resize(total);
+        let mut n = 0usize;
         let mut next = 0usize;
         for &(l, a, b, own) in &out.runs {
             while next <= l as usize {
-                out.start[next] = out.x.len() as u32;
+                out.start[next] = n as u32;
                 next += 1;
             }
             for (s, slot) in (a..b).zip(&self.slots[a as usize..b as usize]) {
                 let w = slot.weight.load(Ordering::Relaxed);
-                if w == REMOVED {
-                    continue;
-                }
                 let q = (slot.position.as_dvec3() - corner) * inv;
-                out.x.push(q.x as f32);
-                out.y.push(q.y as f32);
-                out.z.push(q.z as f32);
-                out.w.push(f32::from_bits(w));
-                out.cell.push(l as u16);
-                out.slot.push(s);
-                out.own.push(own);
+                out.x[n] = q.x as f32;
+                out.y[n] = q.y as f32;
+                out.z[n] = q.z as f32;
+                out.w[n] = f32::from_bits(w);
+                out.cell[n] = l as u16;
+                out.slot[n] = s;
+                out.own[n] = own;
+                n += (w != REMOVED) as usize;
             }
         }
+        out.truncate(n);
         let len = out.x.len() as u32;
         for s in &mut out.start[next..] {
             *s = len;
@@ -517,14 +575,26 @@ impl Default for Neighbourhood {
 }
 
 impl Neighbourhood {
-    fn clear(&mut self) {
-        self.x.clear();
-        self.y.clear();
-        self.z.clear();
-        self.w.clear();
-        self.cell.clear();
-        self.slot.clear();
-        self.own.clear();
+    /// Room for `n` points (one more, for the last, possibly removed, write).
+    fn resize(&mut self, n: usize) {
+        let n = n + 1;
+        self.x.resize(n, 0.0);
+        self.y.resize(n, 0.0);
+        self.z.resize(n, 0.0);
+        self.w.resize(n, 0.0);
+        self.cell.resize(n, 0);
+        self.slot.resize(n, 0);
+        self.own.resize(n, false);
+    }
+
+    fn truncate(&mut self, n: usize) {
+        self.x.truncate(n);
+        self.y.truncate(n);
+        self.z.truncate(n);
+        self.w.truncate(n);
+        self.cell.truncate(n);
+        self.slot.truncate(n);
+        self.own.truncate(n);
     }
 
     /// Number of points.
@@ -710,5 +780,93 @@ mod tests {
             owned,
             (0..pts.len() as u32).filter(|&s| !skipped(s)).count()
         );
+    }
+
+    /// Compaction leaves every gather the same points, in the same order, with the same
+    /// weights and positions, and the same set of live candidate indices, round after round.
+    #[test]
+    fn compaction_keeps_every_gather() {
+        let mut rng = Pcg32::new(4, 7);
+        let pts: Vec<Vec3> = (0..5000)
+            .map(|_| {
+                Vec3::new(
+                    rng.next_f32() * 3.0,
+                    rng.next_f32() * 3.0,
+                    rng.next_f32() * 0.5,
+                )
+            })
+            .collect();
+        let layout = Layout::new(Vec3::ZERO, 0.17);
+        let chunk = |_: usize, emit: &mut dyn FnMut(u32, Vec3)| {
+            for (i, &p) in pts.iter().enumerate() {
+                emit(i as u32, p);
+            }
+        };
+        let counts = vec![count_tiles(&layout, |emit| chunk(0, &mut |_, p| emit(p)))];
+        let mut tiles = Tiles::build(layout, &counts, chunk);
+        assert!(tiles.len() > 8);
+        let snapshot = |tiles: &Tiles| {
+            let mut near = Neighbourhood::default();
+            let mut all = Vec::new();
+            for t in 0..tiles.len() {
+                tiles.gather(t, 0.5, &mut near);
+                let moved: Vec<(Vec3, u32)> = near
+                    .slot
+                    .iter()
+                    .map(|&s| (tiles.slots[s as usize].position, tiles.index[s as usize]))
+                    .collect();
+                all.push((
+                    near.x.clone(),
+                    near.y.clone(),
+                    near.z.clone(),
+                    near.w.clone(),
+                    near.cell.clone(),
+                    near.own.clone(),
+                    moved,
+                ));
+            }
+            let mut live: Vec<u32> = tiles
+                .slots
+                .iter()
+                .zip(&tiles.index)
+                .filter(|(s, _)| !s.removed())
+                .map(|(_, &i)| i)
+                .collect();
+            live.sort_unstable();
+            (all, live)
+        };
+        for (s, slot) in tiles.slots.iter().enumerate() {
+            slot.set_weight(s as f32);
+        }
+        for round in 0..3u32 {
+            // Remove about a third of what is left, at random.
+            for slot in &tiles.slots {
+                if !slot.removed() && rng.next_below(3) == 0 {
+                    slot.set_weight(f32::NEG_INFINITY);
+                }
+            }
+            let before = snapshot(&tiles);
+            tiles.compact();
+            let after = snapshot(&tiles);
+            assert!(before.1.len() < pts.len(), "round {round}");
+            assert_eq!(before.1, after.1, "live set, round {round}");
+            assert_eq!(before.0, after.0, "gathers, round {round}");
+            // Each cell's live slots are at its front, the rest of its slots removed.
+            for (c, (&a, &b)) in tiles.cell_start.iter().zip(&tiles.cell_end).enumerate() {
+                let next = tiles
+                    .cell_start
+                    .get(c + 1)
+                    .copied()
+                    .unwrap_or(tiles.slots.len() as u32);
+                assert!(a <= b && b <= next, "cell {c}");
+                for s in a..next {
+                    assert_eq!(
+                        tiles.slots[s as usize].removed(),
+                        s >= b,
+                        "cell {c}, slot {s}"
+                    );
+                }
+            }
+        }
     }
 }
