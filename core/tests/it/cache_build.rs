@@ -1,12 +1,11 @@
 //! Building the irradiance cache: invariants (`validate`), determinism, degenerate inputs,
 //! errors, and memory per sample.
 
-mod common;
-
-use common::{Rng, box_samples, sphere_samples};
 use lucent_core::cache::{LEAF_CAPACITY, MAX_DEPTH};
 use lucent_core::glam::Vec3;
 use lucent_core::{BuildError, IrradianceCache, Sample};
+
+use crate::common::{Rng, box_samples, sphere_samples};
 
 #[test]
 fn random_sets_validate() {
