@@ -348,7 +348,7 @@ impl Dipole {
     ///
     /// The fourth-order term is what a second-order aggregate leaves: its bias, of the order of
     /// (A/d²)² and negative (Rd's fourth derivative is positive), was −0.3% on a uniformly lit
-    /// plane at ε = 0.5; with the term, −0.02 to −0.07% (`core/tests/plane_bias.rs`).
+    /// plane at ε = 0.5; with the term, −0.02 to −0.07% (`core/tests/it/plane_bias.rs`).
     /// The result is clamped to [0, 2·Rd(r)]: where the expansion is poor (a node many
     /// diffusion lengths wide) the value stays non-negative and within a factor two of the
     /// plain aggregate. Zero moments give Rd exactly.

@@ -1,7 +1,7 @@
 //! The properties behind the fuzz targets in `fuzz/fuzz_targets/`.
 //!
 //! Each function takes the fuzzer's bytes and panics when its property fails. The fuzz targets
-//! are thin wrappers around them, and `tests/tests/fuzz_corpus.rs` replays every file of
+//! are thin wrappers around them, and `tests/tests/it/fuzz_corpus.rs` replays every file of
 //! `fuzz/corpus/<target>/` through the same function, so that the committed seeds and
 //! minimised crashers run in `cargo test --workspace` without a fuzzer. See `docs/fuzzing.md`.
 //!

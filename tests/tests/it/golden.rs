@@ -12,8 +12,8 @@
 //!   changes rounding; every transcendental comes from libm or lucent's own polynomial, so
 //!   nothing else varies) and within 1e-5 relative (+1e-7 absolute) elsewhere.
 //!
-//! Regenerate after an intended change with `LUCENT_BLESS=1 cargo test -p lucent-tests --test
-//! golden`, then look at the images before committing them.
+//! Regenerate after an intended change with `LUCENT_BLESS=1 cargo test -p lucent-tests --test it
+//! golden::`, then look at the images before committing them.
 //!
 //! The README's pictures (`docs/images/`) are checked the same way at full size, and the
 //! bless run rewrites them too.
@@ -111,7 +111,7 @@ fn compare_rgb(what: &str, got: &[Vec3], want: &[Vec3], exact: bool) {
 
 /// `image` encoded as the renderer writes it (8-bit sRGB at `exposure` stops) equals the PNG at
 /// `want`: byte for byte on the pinned build, within one code per channel elsewhere. Regenerate
-/// with `LUCENT_BLESS=1 cargo test -p lucent-tests --test golden`.
+/// with `LUCENT_BLESS=1 cargo test -p lucent-tests --test it golden::`.
 fn assert_png_matches(what: &str, image: &RgbImage, exposure: f32, want: &Path) {
     let actual = std::env::temp_dir().join(format!(
         "lucent-{what}-{}-{}",
@@ -127,7 +127,7 @@ fn assert_png_matches(what: &str, image: &RgbImage, exposure: f32, want: &Path) 
         assert!(
             got == expected,
             "{what}: PNG bytes differ from {} (actual: {}); regenerate with LUCENT_BLESS=1 cargo \
-             test -p lucent-tests --test golden",
+             test -p lucent-tests --test it golden::",
             want.display(),
             actual.display()
         );
@@ -171,7 +171,7 @@ fn renders_match_their_goldens() {
         }
         let missing = |p: &Path| {
             format!(
-                "{} is missing: run LUCENT_BLESS=1 cargo test -p lucent-tests --test golden",
+                "{} is missing: run LUCENT_BLESS=1 cargo test -p lucent-tests --test it golden::",
                 p.display()
             )
         };

@@ -1,7 +1,7 @@
 //! Command-line flags: usage errors (exit 2, printed by clap), and well-formed values that
 //! are out of range, NaN or infinite (exit 1, naming the flag and the value).
 
-use crate::harness::{Sandbox, render};
+use super::harness::{Sandbox, render};
 
 /// Unknown flags, malformed values, missing values, conflicting flags: exit 2.
 #[test]

@@ -208,7 +208,7 @@ fn a_hard_shadow_edge_converges_to_the_supersampled_reference() {
             assert_eq!(a[range.clone()], o[range], "pixel {k} off the edge changed");
         }
     }
-    // Every layer is resolved the same way: radiance stays the §7 conversion of exitance
+    // Every layer is resolved the same way: radiance stays the `docs/physics.md` §17 conversion of exitance
     // (normal incidence here to within 0.1%), local + global = exitance.
     for p in &adaptive.pixels {
         assert!((p.local + p.global - p.exitance).abs().max_element() <= 1e-5 * lit.max(1.0));

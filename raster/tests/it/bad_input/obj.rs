@@ -1,6 +1,6 @@
 //! OBJ meshes: missing, malformed, truncated.
 
-use crate::harness::{CONSTANT, Sandbox, render, scene};
+use super::harness::{CONSTANT, Sandbox, render, scene};
 
 /// A small valid OBJ: an octahedron with texture coordinates and normals (so that a cut can
 /// land inside any kind of statement).

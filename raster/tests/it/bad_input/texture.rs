@@ -1,7 +1,7 @@
 //! PNG textures: missing, not PNG, absurd sizes in the header, truncated, corrupt, and
 //! textures on a mesh without UVs.
 
-use crate::harness::{
+use super::harness::{
     CONSTANT, SPHERE, Sandbox, png_chunk, png_header_only, render, scene, valid_png,
 };
 

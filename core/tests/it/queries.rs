@@ -2,9 +2,6 @@
 //! error in ε, the split methods vs their every-sample formulas, SIMD vs scalar lanes, cull
 //! tolerance, determinism, and the properties every result must have.
 
-mod common;
-
-use common::{Rng, box_samples, rel_err, sphere_samples};
 use lucent_core::cache::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
 use lucent_core::glam::Vec3;
 use lucent_core::lanes::ScalarLanes;
@@ -12,6 +9,8 @@ use lucent_core::{
     Distance, IrradianceCache, LocalIntegralTable, Method, NoStats, Profile, QueryError,
     QuerySettings, QueryStats, ShadingPoint,
 };
+
+use crate::common::{Rng, box_samples, rel_err, sphere_samples};
 
 fn profile(ell: f32) -> Profile {
     Profile::from_reflectance(

@@ -1,5 +1,4 @@
 //! Shared helpers for the core's integration tests: a seeded generator and sample sets.
-#![allow(dead_code)]
 
 use lucent_core::Sample;
 use lucent_core::glam::Vec3;

@@ -1,12 +1,11 @@
 //! Building the irradiance cache: invariants (`validate`), determinism, degenerate inputs,
 //! errors, and memory per sample.
 
-mod common;
-
-use common::{Rng, box_samples, sphere_samples};
 use lucent_core::cache::{LEAF_CAPACITY, MAX_DEPTH};
 use lucent_core::glam::Vec3;
 use lucent_core::{BuildError, IrradianceCache, Sample};
+
+use crate::common::{Rng, box_samples, sphere_samples};
 
 #[test]
 fn random_sets_validate() {
@@ -203,7 +202,7 @@ fn totals_beyond_f32_are_typed_errors() {
     one.validate().unwrap();
 }
 
-/// The memory budget: at most 64 bytes per sample, everything included.
+/// The memory budget: at most 64 bytes per sample, everything included.
 #[test]
 fn memory_per_sample_is_within_budget() {
     for n in [2_000usize, 23_000, 100_000] {

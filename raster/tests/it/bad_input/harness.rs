@@ -19,7 +19,7 @@ pub const PREVIOUS: &[u8] = b"previous contents: must survive a failed run\n";
 const PANIC_EXIT: i32 = 101;
 
 /// A valid scene using every kind of number the format has (camera, shapes, all light
-/// types, every render setting), so that [`crate::scene`] can replace each in turn.
+/// types, every render setting), so that [`super::scene`] can replace each in turn.
 /// `OBJECT` and `MATERIAL` are placeholders for per-test variants.
 pub const TEMPLATE: &str = r#"# bad-input test scene: 32 × 32 pixels, 500 samples
 [camera]

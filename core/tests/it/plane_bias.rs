@@ -28,11 +28,10 @@
 //! of the order of the curvature), so less of the error goes than on the plane.
 //! `bias_table` (ignored) prints every figure.
 
-mod common;
-
-use common::Rng;
 use lucent_core::glam::{DVec3, Vec3};
 use lucent_core::{IrradianceCache, Method, Profile, QuerySettings, Sample, ShadingPoint};
+
+use crate::common::Rng;
 
 /// An n × n grid over a square of side `side` about the origin, each sample moved by up to
 /// `jitter` of a cell (1 = anywhere in its cell), all lit with E = 1.

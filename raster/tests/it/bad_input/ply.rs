@@ -1,7 +1,7 @@
 //! Baked sample sets (`lucent render --samples-from FILE.ply`): missing, truncated,
 //! malformed headers, bad values, and sets baked for another scene.
 
-use crate::harness::{Sandbox, render};
+use super::harness::{Sandbox, render};
 
 /// A sandbox with `samples.ply` baked from its own scene (500 samples). Returns the bytes
 /// and the length of the header.

@@ -1,7 +1,7 @@
 //! Scene files: missing, unreadable, truncated, malformed TOML, NaN and infinities in any
 //! number, resolutions of 0 and 100000².
 
-use crate::harness::{CONSTANT, SPHERE, Sandbox, render, scene};
+use super::harness::{CONSTANT, SPHERE, Sandbox, render, scene};
 
 /// The harness is able to see a run: the template renders, and replaces both outputs.
 #[test]

@@ -1,14 +1,13 @@
-//! The closed-form check of the reference sheet §7: on a flat, uniformly lit surface much
+//! The closed-form check of `docs/physics.md` §12: on a flat, uniformly lit surface much
 //! larger than the diffusion length, every method's exitance is E · Rd_total(α′).
 
-mod common;
-
-use common::{Rng, rel_err};
 use lucent_core::glam::Vec3;
 use lucent_core::{
     Distance, IrradianceCache, LocalIntegralTable, Method, Profile, QuerySettings, Sample,
     ShadingPoint,
 };
+
+use crate::common::{Rng, rel_err};
 
 /// A square grid of spacing `h` over [−half, half]², all with irradiance `e`.
 fn plane(half: f32, h: f32, e: Vec3) -> Vec<Sample> {

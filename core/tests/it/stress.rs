@@ -1,5 +1,5 @@
-//! Numerical stress: the core at the ends of every parameter range (issue 5, "Numerical
-//! stress"). Every test asserts, wherever it looks:
+//! Numerical stress: the core at the ends of every parameter range. Every test asserts,
+//! wherever it looks:
 //!
 //! - no panic, no NaN or infinity in any result (profiles, tables, queries);
 //! - the hierarchical query with ε = 0 and no culling equals the exhaustive sum, the split
@@ -12,18 +12,15 @@
 //!   `BuildError`) instead of garbage.
 //!
 //! The valid ranges found here are documented in `docs/valid-ranges.md`. The quick tests run
-//! in a few seconds with `cargo test -p lucent-core --test stress`; the long sweeps and the
+//! in a few seconds with `cargo test -p lucent-core --test it stress::`; the long sweeps and the
 //! 10-million-sample measurement are `#[ignore]`d:
 //!
 //! ```text
-//! cargo test --release -p lucent-core --test stress -- --ignored --nocapture --test-threads 1
+//! cargo test --release -p lucent-core --test it stress:: -- --ignored --nocapture --test-threads 1
 //! ```
-
-mod common;
 
 use std::time::Instant;
 
-use common::{Rng, sphere_samples};
 use lucent_core::cache::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
 use lucent_core::dipole::AlbedoInverter;
 use lucent_core::glam::Vec3;
@@ -32,11 +29,13 @@ use lucent_core::{
     QuerySettings, Sample, ShadingPoint,
 };
 
+use crate::common::{Rng, sphere_samples};
+
 // ---------------------------------------------------------------------------------------------
 // Shared checks
 // ---------------------------------------------------------------------------------------------
 
-/// The K_d values of the sweeps (the issue's range, 0.001 to 0.999).
+/// The K_d values of the sweeps (the documented range, 0.001 to 0.999).
 const KDS: [f32; 9] = [0.001, 0.01, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 0.999];
 /// The η values of the sweeps (1.0 to 2.5).
 const ETAS: [f32; 6] = [1.0, 1.1, 1.3, 1.5, 2.0, 2.5];
@@ -966,11 +965,11 @@ fn lit_plane_exitance_reaches_the_lambertian_limit() {
 /// The full grid: ℓ_u 1e-6 … 1e6 (two per decade) × K_d 0.001 … 0.999 × η 1.0 … 2.5 × scene
 /// scale 1e-4 … 1e4, on sphere and box sample sets, every method against its oracle.
 #[test]
-#[ignore = "long sweep (about a minute in release): cargo test --release -p lucent-core --test stress -- --ignored"]
+#[ignore = "long sweep (about a minute in release): cargo test --release -p lucent-core --test it stress:: -- --ignored"]
 fn full_parameter_sweep() {
     let start = Instant::now();
     let base = sphere_samples(1200, 1.0, 31);
-    let boxed = common::box_samples(1200, 1.0, 32);
+    let boxed = crate::common::box_samples(1200, 1.0, 32);
     let mut worst = Worst::default();
     let mut runs = 0;
     for scale in decades(-4, 4, 1) {
@@ -1010,7 +1009,7 @@ fn full_parameter_sweep() {
 
 /// 10 million samples: build, validate, memory, and query times per method (reported).
 #[test]
-#[ignore = "needs ~2 GB and about a minute in release: cargo test --release -p lucent-core --test stress -- --ignored"]
+#[ignore = "needs ~2 GB and about a minute in release: cargo test --release -p lucent-core --test it stress:: -- --ignored"]
 fn ten_million_samples() {
     const N: usize = 10_000_000;
     let t = Instant::now();

@@ -336,7 +336,7 @@ fn edge_refined_beats_local_global_and_edge_aware_at_the_edge() {
 }
 
 /// The full table: every method at 5k, 23k and 100k samples, with the per-bin profile
-/// (`cargo test -p lucent-tests --release --test edge_reference -- --ignored --nocapture`).
+/// (`cargo test -p lucent-tests --release --test it edge_reference:: -- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn edge_reference_report() {

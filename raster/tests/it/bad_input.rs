@@ -9,20 +9,13 @@
 //! was — nothing written, nothing overwritten, no temporary file left. `docs/errors.md`
 //! tabulates the cases and their messages, each row naming the test here that backs it.
 //!
-//! Run with `cargo test -p lucent-raster --test bad_input`.
+//! Run with `cargo test -p lucent-raster --test it bad_input::`.
 
-#[path = "bad_input/harness.rs"]
 mod harness;
 
-#[path = "bad_input/flags.rs"]
 mod flags;
-#[path = "bad_input/obj.rs"]
 mod obj;
-#[path = "bad_input/outputs.rs"]
 mod outputs;
-#[path = "bad_input/ply.rs"]
 mod ply;
-#[path = "bad_input/scene.rs"]
 mod scene;
-#[path = "bad_input/texture.rs"]
 mod texture;

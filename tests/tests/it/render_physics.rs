@@ -1,7 +1,7 @@
 //! End-to-end renders of small scenes, checked against physical facts:
 //!
-//! - a uniformly lit translucent plane has radiant exitance E · Rd_total = E · K_d (reference
-//!   sheet §7), for every method, and radiance F_t(η, cos θ)/(π(1 − F_dr,ext)) · M_o;
+//! - a uniformly lit translucent plane has radiant exitance E · Rd_total = E · K_d
+//!   (`docs/physics.md` §12), for every method, and radiance F_t(η, cos θ)/(π(1 − F_dr,ext)) · M_o;
 //! - pixels in an occluder's shadow are darker than lit ones, and the subsurface glow makes
 //!   the shadow's inside edge brighter than its interior;
 //! - the image is the same, bit for bit, on every run and for any thread count.
@@ -121,7 +121,7 @@ fn lit_plane_exitance_is_e_times_kd_for_every_method() {
                         p.irradiance
                     );
                 }
-                // Radiance towards the camera (cos θ ≈ 1 at the centre): the §7 convention.
+                // Radiance towards the camera (cos θ ≈ 1 at the centre): the convention of `docs/physics.md` §17.
                 let want = profile.radiance(m, 1.0);
                 assert!(
                     ((p.color - want).abs() / want).max_element() < 0.005,

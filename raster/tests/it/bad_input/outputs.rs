@@ -1,7 +1,7 @@
 //! Output paths that cannot be written, and `compare` on bad images: nothing is written or
 //! replaced, and no temporary file is left behind.
 
-use crate::harness::{PREVIOUS, Sandbox, render};
+use super::harness::{PREVIOUS, Sandbox, render};
 
 /// PNG and EXR paths in a missing directory, naming a directory, or the same file twice:
 /// rejected before rendering, both outputs untouched.

@@ -4,10 +4,10 @@
 //! the physics promises more (scale invariance, E·Rd_total on a lit plane), that is checked
 //! too. Scenes are parsed from text and rendered through the library, in memory.
 //!
-//! Quick tests: `cargo test -p lucent-raster --test stress`. The long sweep is ignored:
+//! Quick tests: `cargo test -p lucent-raster --test it stress::`. The long sweep is ignored:
 //!
 //! ```text
-//! cargo test --release -p lucent-raster --test stress -- --ignored --nocapture
+//! cargo test --release -p lucent-raster --test it stress:: -- --ignored --nocapture
 //! ```
 
 use lucent_core::glam::Vec3;
@@ -372,7 +372,7 @@ aa = 1
 /// 0.999 × η 1.0 … 2.5 × every method, on the shadow scene: every pixel finite and
 /// non-negative, no error.
 #[test]
-#[ignore = "long sweep (about a minute in release): cargo test --release -p lucent-raster --test stress -- --ignored"]
+#[ignore = "long sweep (about a minute in release): cargo test --release -p lucent-raster --test it stress:: -- --ignored"]
 fn renderer_parameter_sweep() {
     let start = std::time::Instant::now();
     let mut renders = 0;
