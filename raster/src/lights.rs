@@ -328,6 +328,15 @@ fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {
 mod tests {
     use super::*;
 
+    /// A plate over x ∈ [x0, x1], y ∈ [−5, 5] at height h (two triangles).
+    fn plate(x0: f32, x1: f32, h: f32) -> [[Vec3; 3]; 2] {
+        let corner = |x: f32, y: f32| Vec3::new(x, y, h);
+        [
+            [corner(x0, -5.0), corner(x1, -5.0), corner(x1, 5.0)],
+            [corner(x0, -5.0), corner(x1, 5.0), corner(x0, 5.0)],
+        ]
+    }
+
     fn point_light(position: Vec3, intensity: f32) -> Light {
         Light::Point {
             position,
@@ -382,20 +391,6 @@ mod tests {
                 irradiance: 1.0,
             },
         ];
-        let plate = |x0: f32, x1: f32, h: f32| {
-            [
-                [
-                    Vec3::new(x0, -5.0, h),
-                    Vec3::new(x1, -5.0, h),
-                    Vec3::new(x1, 5.0, h),
-                ],
-                [
-                    Vec3::new(x0, -5.0, h),
-                    Vec3::new(x1, 5.0, h),
-                    Vec3::new(x0, 5.0, h),
-                ],
-            ]
-        };
         let mut tris = plate(-3.0, -0.5, 1.5).to_vec();
         tris.extend(plate(0.7, 1.5, 1.0));
         let bvh = Bvh::build(&tris);
@@ -449,20 +444,6 @@ mod tests {
             // Below the surface: never reaches it.
             point_light(Vec3::new(0.0, 0.0, -3.0), 4.0),
         ];
-        let plate = |x0: f32, x1: f32, h: f32| {
-            [
-                [
-                    Vec3::new(x0, -5.0, h),
-                    Vec3::new(x1, -5.0, h),
-                    Vec3::new(x1, 5.0, h),
-                ],
-                [
-                    Vec3::new(x0, -5.0, h),
-                    Vec3::new(x1, 5.0, h),
-                    Vec3::new(x0, 5.0, h),
-                ],
-            ]
-        };
         let mut tris = plate(-3.0, -0.5, 1.5).to_vec();
         tris.extend(plate(0.7, 1.5, 1.0));
         let bvh = Bvh::build(&tris);
