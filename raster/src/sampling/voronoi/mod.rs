@@ -550,7 +550,7 @@ impl Pass<'_> {
             .flat_map_iter(|c| {
                 cells.sites_of(c).map(move |s| {
                     let p = sums[s].1.as_dvec3();
-                    let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0]);
+                    let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0], p);
                     for &t in cells.triangles_of(c) {
                         let tri = &self.triangles[t as usize];
                         let w = nearest_on_triangle(p, tri);
@@ -559,25 +559,20 @@ impl Pass<'_> {
                             + tri[2].as_dvec3() * w[2];
                         let d2 = p.distance_squared(q);
                         if d2 < best.0 {
-                            best = (d2, t, w);
+                            best = (d2, t, w, q);
                         }
                     }
-                    let (_, triangle, w) = best;
-                    if triangle == u32::MAX {
-                        return SurfacePoint {
+                    match best {
+                        (_, u32::MAX, ..) => SurfacePoint {
                             position: cells.sites[s],
-                            triangle,
+                            triangle: u32::MAX,
                             bary: Vec2::ZERO,
-                        };
-                    }
-                    let tri = &self.triangles[triangle as usize];
-                    let position = tri[0].as_dvec3() * w[0]
-                        + tri[1].as_dvec3() * w[1]
-                        + tri[2].as_dvec3() * w[2];
-                    SurfacePoint {
-                        position: position.as_vec3(),
-                        triangle,
-                        bary: Vec2::new(w[1] as f32, w[2] as f32),
+                        },
+                        (_, triangle, w, q) => SurfacePoint {
+                            position: q.as_vec3(),
+                            triangle,
+                            bary: Vec2::new(w[1] as f32, w[2] as f32),
+                        },
                     }
                 })
             })
