@@ -5,7 +5,7 @@
 //! at its representative sub-sample (the covered one nearest the pixel centre) and weighted by
 //! its coverage. That antialiases silhouettes between objects, but not what changes *within*
 //! an object's part of a pixel: a hard shadow edge, a crease, a texture edge. Those stayed
-//! stair-stepped at any `aa`. In the pixels the second pass picks ([`super::refine`]: those
+//! stair-stepped at any `aa`. In the pixels the second pass picks ([`super::antialias`]: those
 //! whose first-pass radiance differs from a neighbour's), each fragment of coverage ≥ 2 is
 //! checked, and split where needed:
 //!

@@ -2,19 +2,20 @@
 //!
 //! ```text
 //! scene ─ prepare ─┬─ samples (Poisson) ─ irradiance (shadow rays) ─ caches + K tables ─┐
-//!                  └─ rasterise (fixed point, supersampled visibility) ───────────────────┴─ shade ─ refine ─ image
+//!                  └─ rasterise (fixed point, supersampled visibility) ───────────────────┴─ shade ─ antialias ─ image
 //! ```
 //!
 //! Work a scene does not need is skipped: no samples, caches or tables without translucent
 //! objects; no BVH or shadow rays when nothing can occlude; no K tables for the unsplit
 //! methods, and table entries only for the ℓ the shading points ask for. Shading runs on a
 //! rayon pool over rows; every pixel depends only on its coordinates, so the image is the same
-//! for any thread count. With `aa > 1`, a second pass (`refine`, `adaptive`) re-shades the
+//! for any thread count. With `aa > 1`, a second pass (`antialias`, `adaptive`) re-shades the
 //! pixels whose sub-samples see different light, normals or material at one point per group of
 //! alike sub-samples; it reads the first pass's image and writes only its own pixels, so it is
 //! deterministic too.
 
 mod adaptive;
+mod antialias;
 mod attributes;
 mod baked;
 mod convexity;
@@ -22,7 +23,6 @@ pub mod density;
 mod edge_refined;
 mod irradiance;
 mod prepare;
-mod refine;
 mod shading;
 
 use std::borrow::Cow;
@@ -463,7 +463,7 @@ fn render_in_pool(
     // Second pass: where the shading varies within a pixel, more points.
     if scene.render.aa > 1 && !options.shade_once {
         let t = Instant::now();
-        let refined = refine::refine(&shading, &mut pixels, options.collect_stats)?;
+        let refined = antialias::refine(&shading, &mut pixels, options.collect_stats)?;
         let counted = refined.stats.traversal;
         traversal.nodes_opened += counted.nodes_opened;
         traversal.aggregates += counted.aggregates;
