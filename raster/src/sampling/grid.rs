@@ -14,6 +14,8 @@
 //! cell_key:   [ (x·8 + y)·8 + z, ... ]                   the cell within its tile (u16)
 //! cell_start: [ 0, 6, 11, ... ]                          first slot of each cell
 //! cell_end:   [ 4, 9, 15, ... ]                          one past its last live slot
+//! plan:       [ (0, 812) (1, 813) ... | ... ]            per tile, the cells its gather
+//! plan_start: [ 0, 140, 297, ... ]                       reads: (local cell, cell index)
 //! ```
 //!
 //! [`Tiles::compact`] moves each cell's live candidates to the front of its slots between
@@ -25,7 +27,11 @@
 //! neighbour tiles (the halo) into a [`Neighbourhood`]: a dense block of `(8 + 2)³` cells in
 //! local coordinates, so that a query is 9 contiguous runs (cells that differ only in z are
 //! adjacent) without hashing. Each tile lists its 26 neighbours (found once through an
-//! open-addressing table of the tile keys).
+//! open-addressing table of the tile keys), and the cells its gather reads, in local order
+//! (found once by binary searches in the neighbours' cell keys: the cells never change, only
+//! how many live candidates they hold). Before copying, a gather counts the live candidates
+//! in a loop of loads alone, so that the cache misses on the halo's scattered slots overlap
+//! instead of waiting behind the copy's stores.
 //!
 //! Building it takes two passes over the candidates, which are generated twice instead of
 //! stored twice (see `poisson.rs`): the first counts the candidates of every tile per chunk
@@ -208,6 +214,11 @@ pub(super) struct Tiles {
     pub(super) slots: Vec<Slot>,
     /// Each slot's candidate index in generation order.
     pub(super) index: Vec<u32>,
+    /// The cells each tile's gather reads, `(local cell, cell index)` in local cell order
+    /// ([`Tiles::gather_plan`]), tile after tile.
+    plan: Vec<(u16, u32)>,
+    /// First entry of each tile in `plan` (+ end).
+    plan_start: Vec<u32>,
 }
 
 impl Tiles {
@@ -362,7 +373,7 @@ impl Tiles {
                 near
             })
             .collect();
-        Tiles {
+        let mut tiles = Tiles {
             layout,
             keys,
             neighbours,
@@ -373,7 +384,21 @@ impl Tiles {
             cell_end,
             slots,
             index,
+            plan: Vec::new(),
+            plan_start: Vec::new(),
+        };
+        let plans: Vec<Vec<(u16, u32)>> = (0..tiles.len())
+            .into_par_iter()
+            .map(|t| tiles.gather_plan(t))
+            .collect();
+        tiles.plan_start = Vec::with_capacity(plans.len() + 1);
+        tiles.plan = Vec::with_capacity(plans.iter().map(Vec::len).sum());
+        for p in plans {
+            tiles.plan_start.push(tiles.plan.len() as u32);
+            tiles.plan.extend(p);
         }
+        tiles.plan_start.push(tiles.plan.len() as u32);
+        tiles
     }
 
     /// Number of tiles.
@@ -438,9 +463,10 @@ impl Tiles {
             });
     }
 
-    /// Copies tile `t`'s candidates and its halo into `out`, with their weights, leaving out
-    /// the removed ones, with positions relative to the tile's corner in units of `unit`.
-    pub(super) fn gather(&self, t: usize, unit: f32, out: &mut Neighbourhood) {
+    /// The cells a gather of tile `t` reads, `(local cell, cell index)` in local cell order:
+    /// the tile's own cells and the adjacent cells of its 26 neighbour tiles. The cells of a
+    /// tile never change, so this is found once, when the tiles are built.
+    fn gather_plan(&self, t: usize) -> Vec<(u16, u32)> {
         let k = TILE_CELLS as i64;
         let local = |key: u16, shift: [i64; 3]| -> Option<usize> {
             let c = [key as i64 / (k * k), key as i64 / k % k, key as i64 % k];
@@ -454,12 +480,11 @@ impl Tiles {
             }
             Some((l[0] * LOCAL_CELLS + l[1]) * LOCAL_CELLS + l[2])
         };
-        out.runs.clear();
+        let mut plan = Vec::new();
         let mut near = self.neighbours[t].iter();
         for dx in -1i64..=1 {
             for dy in -1i64..=1 {
                 for dz in -1i64..=1 {
-                    let own = (dx, dy, dz) == (0, 0, 0);
                     let u = *near.next().expect("27 neighbours");
                     if u == u32::MAX {
                         continue;
@@ -478,10 +503,8 @@ impl Tiles {
                     );
                     let keys = &self.cell_key[first..last];
                     let mut add = |c: usize| {
-                        let key = keys[c] as i64;
-                        if let Some(l) = local(key as u16, [dx, dy, dz]) {
-                            let (a, b) = (self.cell_start[first + c], self.cell_end[first + c]);
-                            out.runs.push((l as u32, a, b, own));
+                        if let Some(l) = local(keys[c], [dx, dy, dz]) {
+                            plan.push((l as u16, (first + c) as u32));
                         }
                     };
                     if dx == 0 && dy == 0 {
@@ -499,14 +522,41 @@ impl Tiles {
                 }
             }
         }
-        out.runs.sort_unstable_by_key(|r| r.0);
+        // Every local cell is one cell of one tile: the keys are unique.
+        plan.sort_unstable_by_key(|&(l, _)| l);
+        plan
+    }
+
+    /// Copies tile `t`'s candidates and its halo into `out`, with their weights, leaving out
+    /// the removed ones, with positions relative to the tile's corner in units of `unit`.
+    pub(super) fn gather(&self, t: usize, unit: f32, out: &mut Neighbourhood) {
+        out.runs.clear();
+        let own_cells = self.tile_cells[t]..self.tile_cells[t + 1];
+        let plan = self.plan_start[t] as usize..self.plan_start[t + 1] as usize;
+        out.runs.extend(self.plan[plan].iter().map(|&(l, c)| {
+            let c = c as usize;
+            let own = own_cells.contains(&(c as u32));
+            (l as u32, self.cell_start[c], self.cell_end[c], own)
+        }));
 
         let corner = self.layout.tile_corner(self.keys[t]);
         let inv = 1.0 / unit as f64;
+        // The live candidates are counted first, in a loop of loads alone: the slots of the
+        // halo are scattered over 26 other tiles and mostly miss the cache, and without stores
+        // in between the processor keeps many of those misses in flight at once.
+        let live: usize = out
+            .runs
+            .iter()
+            .map(|&(_, a, b, _)| {
+                self.slots[a as usize..b as usize]
+                    .iter()
+                    .filter(|s| s.weight.load(Ordering::Relaxed) != REMOVED)
+                    .count()
+            })
+            .sum();
         // Written without a branch on removal (a coin flip in the middle rounds): every slot
         // is copied, and the write position advances only past live ones.
-        let total: usize = out.runs.iter().map(|r| (r.2 - r.1) as usize).sum();
-        out.resize(total);
+        out.resize(live);
         let mut n = 0usize;
         let mut next = 0usize;
         for &(l, a, b, own) in &out.runs {
