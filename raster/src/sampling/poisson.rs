@@ -2,10 +2,12 @@
 //! (Yuksel 2015, "Sample Elimination for Generating Poisson Disk Sample Sets", Computer
 //! Graphics Forum 34(2)), run on spatial tiles in parallel.
 //!
-//! 1. Draw `M = 5N` area-uniform candidates (the paper's recommended ratio), stratified along
-//!    a space-filling curve so that their density is nearly exact at every scale (see
+//! 1. Draw `M = 4N` area-uniform candidates, stratified along a space-filling curve so that their density is nearly exact at every scale (see
 //!    `strata.rs`: with independent uniform candidates the output kept ~1–3% low-frequency
-//!    density noise, which became per-pixel error).
+//!    density noise, which became per-pixel error). The paper recommends `M = 5N`; with
+//!    stratified candidates four per sample give the same sample quality (the box-count noise
+//!    and the renders' per-pixel noise are unchanged, the minimum distance 2% smaller:
+//!    `BENCHMARKS.md`) for a fifth less work.
 //! 2. Give each candidate the weight `w_i = Σ_j (1 − d̂_ij / d_max)^α` over the candidates `j`
 //!    closer than `d_max = 2·r_max`, with `α = 8` (the paper's value) and `r_max` the disk
 //!    radius of hexagonal packing at `N` points: `d_max` = [`hex_spacing`]`(A, N)`. Distances
@@ -27,16 +29,17 @@
 //! to the tile, in units of `d_max`), removes its heaviest own candidates (ties: the first in
 //! local order) until it is down to its target for the round, and writes back the weights of
 //! its candidates and halo. The outcome depends only on the phase order, never on timing or
-//! the thread count. Each tile keeps exactly `⌊C_t/5⌋ − ⌊C_{t−1}/5⌋` candidates in the end
+//! the thread count. Each tile keeps exactly `⌊C_t/4⌋ − ⌊C_{t−1}/4⌋` candidates in the end
 //! (`C_t`: the candidates of tiles `0..=t`), which sums to exactly `N`; round `r` takes every
-//! tile to `quota + excess · (5^((7−r)/8) − 1)/4`, so that the density falls by the same factor
-//! (5^(1/8) ≈ 1.22) everywhere in every round, and the colour order rotates with the round.
+//! tile to `quota + excess · (4^((7−r)/8) − 1)/3`, so that the density falls by the same factor
+//! (4^(1/8) ≈ 1.19) everywhere in every round, and the colour order rotates with the round.
 //! One round (every tile straight to its quota) left a density deficit along the borders of
 //! the tiles processed first (they saw their neighbours at 5× density), measured on a 40 × 40
 //! plane with 60k samples as 1.2–1.35% std of the counts in 4 × 4 boxes; eight rounds give
 //! 0.74–0.86% (the former sequential elimination with quotas per run of 320 candidates along
 //! the curve: 0.76–0.81%), 8 × 8 boxes 0.25–0.27% (0.30–0.37%), minimum distance 0.65–0.66 of
-//! the hexagonal spacing (0.66–0.67). Tiles of 4³ cells cut the box noise further but forced
+//! the hexagonal spacing (0.66–0.67), all with five candidates per sample; with four, 0.65–0.80%,
+//! 0.23–0.32% and 0.64–0.65. Tiles of 4³ cells cut the box noise further but forced
 //! close pairs (minimum distance 0.15), as small quota groups did before.
 //!
 //! **Memory.** Candidates are generated on demand, never stored as surface points: block `b`
@@ -45,7 +48,7 @@
 //! second writes each one's position and index straight to its slot (a counting sort), and
 //! after the elimination a third regenerates the blocks and keeps the survivors. What is held
 //! per candidate is its slot (position and weight, 16 B; a removal sets the weight to −∞) and
-//! its index (4 B): per sample (five candidates) about 105 B, then 24 B for the output, the
+//! its index (4 B): per sample (four candidates) about 85 B, then 24 B for the output, the
 //! peak of a whole render (the cache build holds less). The tiles' cell lists and neighbour
 //! tables are a few bytes per sample.
 //!
@@ -57,11 +60,12 @@
 //! Between rounds each tile's live candidates are moved to the front of their cells
 //! (`Tiles::compact`), so a gather reads only live slots (about 22 instead of 40 slot reads
 //! per sample over the eight rounds) and copies them without a branch on removal; the
-//! gathered neighbourhoods, hence the samples, are the same as without it. About 6.4 s of CPU
+//! gathered neighbourhoods, hence the samples, are the same as without it. About 3.8 s of CPU
 //! for 1M samples on the sphere with two threads on this machine, spread over the cores by
 //! the phases (`examples/placement_cost.rs`; figures in `BENCHMARKS.md`). By perf, the largest
-//! parts are the gathers (about a fifth, half of it the first load of a slot that misses the
-//! cache, which is why a slot holds its weight and removal), the max-tree updates, the weight
+//! parts are the gathers (about a sixth, half of it the first load of a slot that misses the
+//! cache, which is why a slot holds its weight and removal, and why a gather counts the live
+//! slots before it copies them), the max-tree updates, the weight
 //! sums and removals, and the three generation passes (~15%).
 //!
 //! Alternatives considered: dart throwing cannot hit an exact count; keeping each candidate's
@@ -81,8 +85,9 @@ use super::rng::{Pcg32, splitmix64};
 use super::strata::Strata;
 use super::surface::{AreaDistribution, SampleTarget, SurfacePoint, hex_spacing};
 
-/// Candidates per output sample (Yuksel 2015 §5: quality saturates around 5).
-const CANDIDATE_RATIO: usize = 5;
+/// Candidates per output sample (Yuksel 2015 §5 recommends 5; with stratified candidates 4
+/// gives the same quality: see the module documentation).
+const CANDIDATE_RATIO: usize = 4;
 /// `(N/M)^γ` with `γ = 1.5` (the weight limiting exponent) and `M/N` the candidate ratio,
 /// written as `1 / (R·√R)`: `sqrt` is correctly rounded everywhere, `powf` is not, and the
 /// samples must be the same bits on every platform.
@@ -263,10 +268,10 @@ pub fn poisson_samples_with_progress(
 }
 
 /// The share of each tile's excess candidates (over its quota) left after each round:
-/// `(R^((ROUNDS − 1 − r)/ROUNDS) − 1) / (R − 1)` for round `r` and the candidate ratio R = 5,
-/// so that the density falls by the same factor, 5^(1/8) ≈ 1.22, every round. (Constants, not
+/// `(R^((ROUNDS − 1 − r)/ROUNDS) − 1) / (R − 1)` for round `r` and the candidate ratio R = 4,
+/// so that the density falls by the same factor, 4^(1/8) ≈ 1.19, every round. (Constants, not
 /// `powf`, whose rounding differs between platforms.)
-const SCHEDULE: [f64; ROUNDS as usize] = [0.772, 0.586, 0.434, 0.309, 0.207, 0.124, 0.056, 0.0];
+const SCHEDULE: [f64; ROUNDS as usize] = [0.788, 0.610, 0.460, 0.333, 0.227, 0.138, 0.063, 0.0];
 
 /// A task's working memory, reused across its tiles.
 #[derive(Default)]

@@ -25,7 +25,7 @@
 //! Pieces are implicit: only the triangles are stored (index, subdivision depth, cumulative
 //! area: 13 bytes each), and a piece's corners are decoded from its number (two bits per
 //! level). Storing the pieces themselves cost ~80 bytes per sample at the default ratio of
-//! five candidates. The cumulative areas are strictly increasing along `i`, so a run of
+//! four candidates. The cumulative areas are strictly increasing along `i`, so a run of
 //! consecutive candidates walks the triangles forward instead of searching them.
 
 use glam::{DVec3, Vec2, Vec3};

@@ -117,8 +117,8 @@ fn fingerprint(s: &[SurfacePoint]) -> u64 {
 fn output_is_pinned() {
     let s = poisson_samples(&sphere_and_plane(), SampleTarget::Count(300), 42).unwrap();
     // Re-pinned when the elimination became tiled (parallel phases, per-tile quotas) and the
-    // strata implicit.
-    assert_eq!(fingerprint(&s), 7_270_598_539_622_339_621);
+    // strata implicit, and when the candidates went from five per sample to four.
+    assert_eq!(fingerprint(&s), 12_065_296_938_678_942_507);
 }
 
 #[test]
@@ -202,8 +202,10 @@ fn samples_keep_their_distance_unlike_uniform_random() {
     let hex = hex_spacing(total_area(&square), n);
     let s = poisson_samples(&square, SampleTarget::Count(n), 9).unwrap();
     let d = min_distance(&positions(&s));
+    // Four candidates per sample reach 0.64–0.65 of the hexagonal spacing (five: 0.65–0.66;
+    // Yuksel's weight limiting lets pairs come closer the fewer candidates there are).
     assert!(
-        d >= 0.65 * hex,
+        d >= 0.63 * hex,
         "min distance {d} = {} of hex spacing",
         d / hex
     );
