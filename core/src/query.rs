@@ -8,12 +8,15 @@
 //! | [`Method::EdgeRefined`] (departure from N10, §16) | as N10 where the irradiance within α is uniform; elsewhere local = ∫ w·Rd·E dA′ by a quadrature of E(x′) that the caller evaluates ([`crate::refine`]) |
 //! | [`Method::Exhaustive`] (§9) | M_o = Σ_all Rd·E·A |
 
+use alloc::string::String;
 use core::fmt;
+use core::str::FromStr;
 
 use glam::{DVec3, Vec3};
 
 use crate::cache::traverse::{EDGE_AWARE, FLUX_HEADROOM, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
 use crate::cache::{self, IrradianceCache};
+use crate::error::ParseMethodError;
 use crate::kernel::Kernel;
 use crate::lanes::{DefaultLanes, Lanes};
 use crate::profile::Profile;
@@ -31,13 +34,13 @@ pub enum Method {
     /// (soft, faithful shadow edges), computed in the same traversal.
     #[default]
     EdgeAware,
-    /// Every sample, no approximation.
-    Exhaustive,
     /// N10's traversal and result where the samples' irradiance within α is within
     /// [`crate::refine::EDGE_THRESHOLD`] of E(x); elsewhere the query flags the point
     /// ([`Exitance::refine`]) and the caller replaces the local term by a quadrature of the
     /// irradiance over the α-disc ([`crate::LocalQuadrature`], [`Exitance::with_local`]).
     EdgeRefined,
+    /// Every sample, no approximation.
+    Exhaustive,
 }
 
 impl Method {
@@ -46,8 +49,8 @@ impl Method {
         Method::Hierarchical,
         Method::LocalGlobal,
         Method::EdgeAware,
-        Method::Exhaustive,
         Method::EdgeRefined,
+        Method::Exhaustive,
     ];
 
     /// The kebab-case name used by the scene format and the command line.
@@ -56,8 +59,8 @@ impl Method {
             Method::Hierarchical => "hierarchical",
             Method::LocalGlobal => "local-global",
             Method::EdgeAware => "edge-aware",
-            Method::Exhaustive => "exhaustive",
             Method::EdgeRefined => "edge-refined",
+            Method::Exhaustive => "exhaustive",
         }
     }
 
@@ -67,6 +70,27 @@ impl Method {
             self,
             Method::LocalGlobal | Method::EdgeAware | Method::EdgeRefined
         )
+    }
+}
+
+impl fmt::Display for Method {
+    /// The [`Method::name`].
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = ParseMethodError;
+
+    /// The method whose [`Method::name`] is `s` (exactly; the error lists the valid names).
+    fn from_str(s: &str) -> Result<Method, ParseMethodError> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| ParseMethodError {
+                name: String::from(s),
+            })
     }
 }
 
