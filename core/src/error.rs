@@ -5,6 +5,9 @@ use core::fmt;
 
 use crate::query::Method;
 
+pub use crate::cache::ValidationError;
+pub use crate::query::QueryError;
+
 /// An invalid material parameter.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ParamError {
@@ -27,7 +30,7 @@ pub enum ParamError {
         /// The offending value.
         value: f32,
     },
-    /// A relative index of refraction above [`crate::dipole::MAX_ETA`], where the dipole's
+    /// A relative index of refraction above [`crate::Profile::MAX_ETA`], where the dipole's
     /// Fresnel fit (and with it the profile) stops being valid.
     EtaAboveMax {
         /// The offending value.

@@ -101,9 +101,22 @@ pub struct LocalQuadrature {
 }
 
 impl LocalQuadrature {
+    /// The rings of the edge-refined method (chosen by measurement, see `BENCHMARKS.md`).
+    pub const DEFAULT_RINGS: usize = DEFAULT_RINGS;
+    /// The nodes per ring of the edge-refined method.
+    pub const DEFAULT_PER_RING: usize = DEFAULT_PER_RING;
+    /// The most nodes a quadrature has: the length of the `at_nodes` slice
+    /// [`LocalQuadrature::local_term`] reads at most.
+    pub const MAX_NODES: usize = MAX_NODES;
+    /// The edge test's threshold τ of [`crate::Method::EdgeRefined`]: a point is flagged
+    /// ([`crate::Exitance::refine`]) unless every sample within α has its irradiance (summed
+    /// over the channels) in [(1 − τ)·E(x), E(x)/(1 − τ)].
+    pub const EDGE_THRESHOLD: f32 = EDGE_THRESHOLD;
+
     /// The quadrature for `profile` and smoothing radius `alpha` with `rings` radii and
     /// `per_ring` angles (each clamped to 1 ..= its maximum, and rings·per_ring to
-    /// [`MAX_NODES`] by reducing the rings). α = 0 or non-finite gives one node at x.
+    /// [`LocalQuadrature::MAX_NODES`] by reducing the rings). α = 0 or non-finite gives one
+    /// node at x.
     pub fn new(profile: &Profile, alpha: f32, rings: usize, per_ring: usize) -> Self {
         let per_ring = per_ring.clamp(1, MAX_PER_RING);
         let rings = rings.clamp(1, MAX_RINGS).min(MAX_NODES / per_ring);

@@ -10,7 +10,7 @@
 use std::time::Duration;
 
 use glam::Vec3;
-use lucent_core::QueryStats;
+use lucent_core::stats::QueryStats;
 
 use super::BenchError;
 use super::scenes::BenchScene;

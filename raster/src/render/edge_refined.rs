@@ -1,5 +1,5 @@
 //! The edge-refined local term at one shading point: the irradiance at the core's quadrature
-//! nodes on the tangent disc ([`lucent_core::refine`]), from the same lights, occluders and
+//! nodes on the tangent disc ([`lucent_core::LocalQuadrature`]), from the same lights, occluders and
 //! shadow rays that light the irradiance samples.
 //!
 //! Called only where the edge-refined query flagged the point (the samples' irradiance within
@@ -14,7 +14,6 @@
 //! ```
 
 use glam::Vec3;
-use lucent_core::refine::{DEFAULT_PER_RING, DEFAULT_RINGS};
 use lucent_core::{Exitance, LocalQuadrature, Profile};
 
 use crate::lights::{Lighting, ShadowHints};
@@ -22,7 +21,12 @@ use crate::sampling::rng::splitmix64;
 
 /// The quadrature of the edge-refined method for `profile` and α (the default node count).
 pub fn quadrature(profile: &Profile, alpha: f32) -> LocalQuadrature {
-    LocalQuadrature::new(profile, alpha, DEFAULT_RINGS, DEFAULT_PER_RING)
+    LocalQuadrature::new(
+        profile,
+        alpha,
+        LocalQuadrature::DEFAULT_RINGS,
+        LocalQuadrature::DEFAULT_PER_RING,
+    )
 }
 
 /// What the refinement needs to know about the shading point.
@@ -50,7 +54,7 @@ pub fn refine(
 ) -> Exitance {
     let (t1, t2) = point.normal.any_orthonormal_pair();
     let rotation = LocalQuadrature::rotation(splitmix64(point.seed ^ 0x005E_ED0F_ED6E));
-    let mut at = [Vec3::ZERO; lucent_core::refine::MAX_NODES];
+    let mut at = [Vec3::ZERO; lucent_core::LocalQuadrature::MAX_NODES];
     for (n, e) in at.iter_mut().enumerate().take(quadrature.len()) {
         let o = quadrature.offset(n, rotation);
         let p = point.position + t1 * o.x + t2 * o.y + point.normal * quadrature.lift(n);

@@ -31,7 +31,8 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lucent_core::{IrradianceCache, NoStats, QuerySettings, QueryStats};
+use lucent_core::stats::{NoStats, QueryStats};
+use lucent_core::{IrradianceCache, QuerySettings};
 use rayon::prelude::*;
 
 pub use adaptive::{GroupScratch, ShadeGroup};
@@ -397,7 +398,6 @@ fn render_in_pool(
             method,
             epsilon: settings.epsilon,
             cull_tolerance: settings.cull_tolerance,
-            smoothing_radius: 0.0,
         },
         exact_local_integral: options.exact_local_integral,
         irradiance_everywhere: options.irradiance_layer || scene.output.layers.irradiance,

@@ -8,7 +8,8 @@
 
 use lucent_core::Method;
 use lucent_core::glam::Vec3;
-use lucent_core::{Distance, Profile, fresnel};
+use lucent_core::internals::fresnel;
+use lucent_core::{Distance, Profile};
 use lucent_raster::render::{RenderOptions, render};
 use lucent_raster::scene::{Scene, SceneOrigin, parse_scene};
 
