@@ -163,8 +163,10 @@ pub struct Exitance {
 
 impl Exitance {
     /// The same result with the local term replaced (the edge-refined method's quadrature):
-    /// total = local + global; `local_irradiance` becomes local / K per channel (0 where K is).
-    pub fn with_local(self, local: Vec3, k: Vec3) -> Exitance {
+    /// total = local + global; `local_irradiance` becomes local / K per channel (0 where K is),
+    /// K the one the query was given (`term`).
+    pub fn with_local(self, local: Vec3, term: LocalTerm) -> Exitance {
+        let k = term.k();
         let e = Vec3::select(k.cmpgt(Vec3::ZERO), local / k, Vec3::ZERO);
         Exitance {
             total: local + self.global,

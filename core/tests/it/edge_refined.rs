@@ -107,7 +107,7 @@ fn the_edge_test_matches_brute_force_and_falls_back_to_edge_aware() {
                 assert_eq!(refined, aware, "x {x}");
             }
             // Replacing the local term keeps the global sum and adds up.
-            let r = refined.with_local(e * k, k);
+            let r = refined.with_local(e * k, term(alpha, k));
             assert_eq!(r.total, e * k + aware.global);
             assert_eq!(r.local_irradiance, e);
         }

@@ -14,7 +14,7 @@
 //! ```
 
 use glam::Vec3;
-use lucent_core::{Exitance, LocalQuadrature, Profile};
+use lucent_core::{Exitance, LocalQuadrature, LocalTerm, Profile};
 
 use crate::lights::{Lighting, ShadowHints};
 use crate::sampling::rng::splitmix64;
@@ -38,8 +38,8 @@ pub struct RefinePoint {
     pub normal: Vec3,
     /// E(x).
     pub irradiance: Vec3,
-    /// K at x.
-    pub k: Vec3,
+    /// The local term (α and K) the query at x was given.
+    pub local: LocalTerm,
     /// The shading point's seed (rotation of the pattern, area-light strata of the nodes).
     pub seed: u64,
 }
@@ -61,8 +61,8 @@ pub fn refine(
         let seed = splitmix64(point.seed.wrapping_add((n as u64 + 1) << 48));
         *e = lighting.irradiance_with(p, point.normal, seed, shadows);
     }
-    let local = quadrature.local_term(point.irradiance, point.k, &at[..quadrature.len()]);
-    m.with_local(local, point.k)
+    let local = quadrature.local_term(point.irradiance, point.local, &at[..quadrature.len()]);
+    m.with_local(local, point.local)
 }
 
 #[cfg(test)]
@@ -85,7 +85,8 @@ mod tests {
         }];
         let lighting = Lighting::new(&lights, None, 10.0);
         let q = quadrature(&marble(), 0.08);
-        let k = Vec3::new(0.3, 0.25, 0.2);
+        let local = LocalTerm::exact(&marble(), 0.08).unwrap();
+        let k = local.k();
         for seed in [0u64, 1, 77, u64::MAX] {
             let position = Vec3::new(0.3, -1.2, 0.0);
             let e = lighting.irradiance(position, Vec3::Z, seed);
@@ -93,7 +94,7 @@ mod tests {
                 position,
                 normal: Vec3::Z,
                 irradiance: e,
-                k,
+                local,
                 seed,
             };
             let m = Exitance {

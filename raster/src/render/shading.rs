@@ -336,7 +336,7 @@ impl Shading<'_> {
                         position,
                         normal,
                         irradiance: e,
-                        k: local.k(),
+                        local,
                         seed,
                     };
                     edge_refined::refine(&lighting, &q, &at, shadows, m)
