@@ -178,7 +178,7 @@ impl BenchConfig {
                 epsilon,
             })
             .collect();
-        for method in [Method::LocalGlobal, Method::EdgeAware, Method::EdgeRefined] {
+        for method in Method::ALL.into_iter().filter(|m| m.is_split()) {
             s.push(MethodSetting {
                 method,
                 epsilon: self.split_epsilon,

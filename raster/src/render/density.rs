@@ -175,8 +175,9 @@ impl DensityPlan {
             DensityOrigin::Baked => format!("a baked set of {} samples", self.count),
         };
         let name = method.name();
+        // The unsplit methods sum the samples alone; the split ones smooth over α.
         let effect = match method {
-            Method::Hierarchical | Method::Exhaustive if ratio >= BLACK_SPACING => {
+            m if !m.is_split() && ratio >= BLACK_SPACING => {
                 let spacing = self.spacing();
                 let lost: Vec<&str> = (0..3)
                     .filter(|&c| spacing >= BLACK_SPACING * f.channels[c])
@@ -194,10 +195,10 @@ impl DensityPlan {
                     )
                 }
             }
-            Method::Hierarchical | Method::Exhaustive => format!(
+            m if !m.is_split() => format!(
                 "{name} will show blotches (bright spots at the samples, dark between them)"
             ),
-            Method::LocalGlobal | Method::EdgeAware | Method::EdgeRefined => {
+            _ => {
                 let alpha = smoothing * (self.area / f64::from(self.count.max(1))).sqrt() as f32;
                 format!(
                     "{name} will render hard, stair-stepped shadow edges (its smoothing radius \
@@ -665,12 +666,7 @@ mod tests {
         // At or below ℓ_d: no warning, for any method.
         let fine = plan_with(DensityOrigin::Count, 23_000, 0.107);
         assert!(fine.ratio() <= WARN_SPACING);
-        for m in [
-            Method::Hierarchical,
-            Method::LocalGlobal,
-            Method::EdgeAware,
-            Method::Exhaustive,
-        ] {
+        for m in Method::ALL {
             assert_eq!(fine.warning(m, 1.5), None);
         }
     }
