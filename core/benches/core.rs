@@ -6,12 +6,13 @@
 //! per method (nodes opened and profile evaluations per query), which divan cannot report.
 
 use divan::{Bencher, black_box};
-use lucent_core::cache::exhaustive_sum_lanes;
 use lucent_core::glam::Vec3;
-use lucent_core::lanes::{Lanes, ScalarLanes, SimdLanes};
+use lucent_core::internals::exhaustive_sum_lanes;
+use lucent_core::internals::{Lanes, ScalarLanes, SimdLanes};
+use lucent_core::stats::{NoStats, QueryStats};
 use lucent_core::{
-    IrradianceCache, LocalIntegralTable, Method, NoStats, Profile, QuerySettings, QueryStats,
-    Sample, ShadingPoint,
+    IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, QuerySettings, Sample,
+    ShadingPoint,
 };
 
 const N: usize = 23_000;
@@ -52,8 +53,7 @@ fn samples(n: usize) -> Vec<Sample> {
 struct Setup {
     cache: IrradianceCache,
     profile: Profile,
-    k: Vec3,
-    alpha: f32,
+    k: LocalTerm,
     points: Vec<ShadingPoint>,
     table: LocalIntegralTable,
 }
@@ -66,7 +66,7 @@ fn setup() -> &'static Setup {
             Profile::from_preset(lucent_core::presets::find("marble").unwrap(), 10.0).unwrap();
         let alpha = cache.smoothing_radius(1.5);
         let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0).unwrap();
-        let k = table.lookup(profile.mean_free_path());
+        let k = table.local_term(profile.mean_free_path());
         let mut rng = Rng(2);
         let points = (0..QUERIES)
             .map(|_| {
@@ -81,19 +81,17 @@ fn setup() -> &'static Setup {
             cache,
             profile,
             k,
-            alpha,
             points,
             table,
         }
     })
 }
 
-fn settings_eps(method: Method, alpha: f32, epsilon: f32) -> QuerySettings {
+fn settings_eps(method: Method, epsilon: f32) -> QuerySettings {
     QuerySettings {
         method,
         epsilon,
         cull_tolerance: 1e-4,
-        smoothing_radius: alpha,
     }
 }
 
@@ -124,7 +122,7 @@ fn main() {
                     &s.profile,
                     p,
                     s.k,
-                    &settings_eps(method, s.alpha, epsilon),
+                    &settings_eps(method, epsilon),
                     &mut stats,
                 )
                 .unwrap();
@@ -182,7 +180,7 @@ fn build(b: Bencher, n: usize) {
 
 fn run_queries<L: Lanes>(b: Bencher, method: Method, epsilon: f32) {
     let s = setup();
-    let settings = settings_eps(method, s.alpha, epsilon);
+    let settings = settings_eps(method, epsilon);
     b.counter(divan::counter::ItemsCount::new(QUERIES))
         .bench(|| {
             let mut acc = Vec3::ZERO;

@@ -1,5 +1,6 @@
 //! Runs one query configuration in a loop, for profiling (`perf record`):
-//! `cargo run --release -p lucent-core --example profile_query -- [hierarchical|local-global|edge-aware] [ε] [seconds]`.
+//! `cargo run --release -p lucent-core --example profile_query -- [METHOD] [ε] [seconds]`
+//! (METHOD one of `Method::ALL`'s names; default hierarchical).
 
 use lucent_core::glam::Vec3;
 use lucent_core::{
@@ -8,10 +9,9 @@ use lucent_core::{
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let method = match args.get(1).map(String::as_str) {
-        Some("local-global") => Method::LocalGlobal,
-        Some("edge-aware") => Method::EdgeAware,
-        _ => Method::Hierarchical,
+    let method = match args.get(1) {
+        Some(name) => name.parse().unwrap_or_else(|e| panic!("{e}")),
+        None => Method::Hierarchical,
     };
     let epsilon: f32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(0.4);
     let seconds: f64 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5.0);
@@ -55,12 +55,11 @@ fn main() {
     let alpha = cache.smoothing_radius(1.5);
     let k = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0)
         .unwrap()
-        .lookup(profile.mean_free_path());
+        .local_term(profile.mean_free_path());
     let settings = QuerySettings {
         method,
         epsilon,
         cull_tolerance: 1e-4,
-        smoothing_radius: alpha,
     };
     let start = std::time::Instant::now();
     let mut queries = 0u64;

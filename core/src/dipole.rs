@@ -290,6 +290,7 @@ impl Dipole {
 
     /// Rd on eight squared distances at once; the same formula as [`Dipole::rd`].
     #[inline(always)]
+    #[doc(hidden)]
     pub fn rd_lanes<L: Lanes>(&self, r2: L) -> L {
         let r2 = r2.min(L::splat(MAX_R2));
         let sigma = L::splat(self.sigma_tr);
@@ -353,6 +354,7 @@ impl Dipole {
     /// diffusion lengths wide) the value stays non-negative and within a factor two of the
     /// plain aggregate. Zero moments give Rd exactly.
     #[inline(always)]
+    #[doc(hidden)]
     pub fn rd_lanes_corrected<L: Lanes>(&self, r2: L, m: &NodeMoments<L>) -> L {
         let r2 = r2.min(L::splat(MAX_R2));
         let sigma = L::splat(self.sigma_tr);

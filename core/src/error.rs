@@ -1,6 +1,12 @@
 //! Typed errors. Nothing in the core panics on bad input; it returns one of these.
 
+use alloc::string::String;
 use core::fmt;
+
+use crate::query::Method;
+
+pub use crate::cache::ValidationError;
+pub use crate::query::QueryError;
 
 /// An invalid material parameter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,7 +30,7 @@ pub enum ParamError {
         /// The offending value.
         value: f32,
     },
-    /// A relative index of refraction above [`crate::dipole::MAX_ETA`], where the dipole's
+    /// A relative index of refraction above [`crate::Profile::MAX_ETA`], where the dipole's
     /// Fresnel fit (and with it the profile) stops being valid.
     EtaAboveMax {
         /// The offending value.
@@ -154,3 +160,52 @@ impl fmt::Display for BuildError {
 }
 
 impl core::error::Error for BuildError {}
+
+/// A method name that is not one of [`Method::ALL`]'s names (from `str::parse::<Method>`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParseMethodError {
+    /// The name that was given.
+    pub name: String,
+}
+
+impl fmt::Display for ParseMethodError {
+    /// `unknown method `NAME` (expected one of: hierarchical, …)`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "unknown method `{}` (expected one of: ", self.name)?;
+        for (i, m) in Method::ALL.iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            f.write_str(m.name())?;
+        }
+        f.write_str(")")
+    }
+}
+
+impl core::error::Error for ParseMethodError {}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use alloc::string::ToString;
+
+    use super::*;
+
+    #[test]
+    fn every_name_parses_back_and_unknown_names_list_them_all() {
+        for m in Method::ALL {
+            assert_eq!(m.name().parse::<Method>(), Ok(m));
+            assert_eq!(m.to_string(), m.name());
+        }
+        let err = "fast".parse::<Method>().unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "unknown method `fast` (expected one of: hierarchical, local-global, edge-aware, \
+             edge-refined, exhaustive)"
+        );
+        // Case and whitespace matter: the scene format and the command line are exact.
+        assert!("Edge-Aware".parse::<Method>().is_err());
+        assert!(" edge-aware".parse::<Method>().is_err());
+    }
+}

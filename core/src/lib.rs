@@ -2,15 +2,23 @@
 //!
 //! Point-based subsurface scattering for translucent materials, `#![no_std]` with `alloc`:
 //!
-//! - the classical dipole of Jensen et al. 2001 ([`Dipole`], [`Profile`]), from coefficients,
-//!   artist parameters or measured presets, with the project's exitance → radiance convention;
-//! - an irradiance cache ([`IrradianceCache`]): a linear octree over Morton-sorted, quantised
-//!   sample positions in flat structure-of-arrays, queried 8 nodes or 8 samples at a time;
-//! - five queries ([`Method`]): hierarchical (Jensen & Buhler 2002), local-global (Langlands &
-//!   Mertens 2007), edge-aware (Neulander 2010), exhaustive, and edge-refined (edge-aware with
-//!   the local term a quadrature of the irradiance at edges, [`refine`]);
-//! - the local-integral table of Neulander 2010 ([`LocalIntegralTable`]), cached at powers of
-//!   two of the mean free path and interpolated, lock-free.
+//! - the classical dipole of Jensen et al. 2001 ([`Profile`], per channel a [`Dipole`]), from
+//!   coefficients, artist parameters ([`Distance`]) or measured [`presets`], with the
+//!   project's exitance → radiance convention;
+//! - an irradiance cache ([`IrradianceCache`] of [`Sample`]s): a linear octree over
+//!   Morton-sorted, quantised sample positions in flat structure-of-arrays, queried 8 nodes or
+//!   8 samples at a time;
+//! - five queries ([`Method`]) at a [`ShadingPoint`], giving an [`Exitance`]: hierarchical
+//!   (Jensen & Buhler 2002), local-global (Langlands & Mertens 2007), edge-aware (Neulander
+//!   2010), edge-refined (edge-aware with the local term a quadrature of the irradiance at
+//!   edges, [`LocalQuadrature`]) and exhaustive;
+//! - the local integral K of the split methods, bound to its smoothing radius α in a
+//!   [`LocalTerm`]: from the table of Neulander 2010 ([`LocalIntegralTable`], cached at powers
+//!   of two of the mean free path and interpolated, lock-free), from tables over a
+//!   texture-mapped reflectance ([`LocalIntegralByKd`]), or by quadrature
+//!   ([`LocalTerm::exact`]).
+//!
+//! Errors are typed ([`error`]); traversal counters for benchmarks are in [`stats`].
 //!
 //! Lengths are in scene units, coefficients in inverse scene units, irradiance and exitance in
 //! any consistent radiometric unit. η is the relative index inside / outside.
@@ -18,8 +26,9 @@
 //! # Quick start
 //!
 //! ```
-//! use lucent_core::{IrradianceCache, LocalIntegralTable, Method, Profile, QuerySettings, Sample, ShadingPoint};
 //! use lucent_core::glam::Vec3;
+//! use lucent_core::{IrradianceCache, LocalIntegralTable, Method, Profile, QuerySettings};
+//! use lucent_core::{Sample, ShadingPoint};
 //!
 //! // Marble, modelled in centimetres (10 mm per scene unit).
 //! let marble = lucent_core::presets::find("marble").unwrap();
@@ -36,20 +45,25 @@
 //! let cache = IrradianceCache::build(&samples)?;
 //! cache.validate()?;
 //!
-//! // Edge-aware query (N10) with smoothing radius α = 2·√Ā.
+//! // Edge-aware query (N10) with smoothing radius α = 2·√Ā; the table hands out K bound to α.
 //! let alpha = cache.smoothing_radius(2.0);
 //! let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0)?;
-//! let settings = QuerySettings { method: Method::EdgeAware, smoothing_radius: alpha, ..Default::default() };
+//! let local = table.local_term(profile.mean_free_path());
+//! let settings = QuerySettings { method: Method::EdgeAware, ..Default::default() };
 //! let point = ShadingPoint { position: Vec3::new(0.01, 0.02, 0.0), irradiance: Vec3::ONE };
-//! let k = table.lookup(profile.mean_free_path());
-//! let m = cache.query(&profile, &point, k, &settings)?;
-//! assert!(m.total.min_element() > 0.0 && m.total.max_element() < 1.0);
+//! let m = cache.query(&profile, &point, local, &settings)?;
+//!
+//! // Far from the patch's edges a uniformly lit surface gives back E·Rd_total = E·K_d.
+//! let rd_total = profile.total_reflectance();
+//! assert!(((m.total - rd_total) / rd_total).abs().max_element() < 0.01);
 //!
 //! // Radiance towards a viewer at 30° from the normal.
 //! let radiance = profile.radiance(m.total, 30f32.to_radians().cos());
 //! # assert!(radiance.is_finite());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! `core/examples/embed.rs` runs every method on such a patch.
 //!
 //! # Features
 //!
@@ -60,30 +74,82 @@
 
 extern crate alloc;
 
-pub mod cache;
-pub mod dipole;
+mod cache;
+mod dipole;
 pub mod error;
-pub mod fresnel;
-pub mod kernel;
-pub mod lanes;
-pub mod math;
-pub mod morton;
+mod fresnel;
+mod kd_tables;
+mod kernel;
+mod lanes;
+mod local_term;
+mod math;
+mod morton;
 pub mod presets;
-pub mod profile;
-pub mod quadrature;
-pub mod query;
-pub mod refine;
+mod profile;
+mod quadrature;
+mod query;
+mod refine;
 pub mod stats;
-pub mod table;
+mod table;
 
+/// The vector types of the API (`Vec3` for positions and RGB values), re-exported so that an
+/// embedder uses the same glam version.
 pub use glam;
 
 pub use cache::{IrradianceCache, Sample};
 pub use dipole::Dipole;
-pub use error::{BuildError, ParamError};
-pub use kernel::Kernel;
+pub use kd_tables::LocalIntegralByKd;
+pub use local_term::LocalTerm;
 pub use profile::{Distance, Profile};
-pub use query::{Exitance, Method, QueryError, QuerySettings, ShadingPoint};
+pub use query::{Exitance, Method, QuerySettings, ShadingPoint};
 pub use refine::LocalQuadrature;
-pub use stats::{NoStats, QueryStats, StatsSink};
 pub use table::LocalIntegralTable;
+
+/// Implementation details that the renderer, the test suites, the benchmarks and the fuzz
+/// targets of this repository need: the lane types, the exhaustive oracles, the dipole and
+/// kernel in closed form, the quadratures. **Unstable**: not part of the API, changed without
+/// notice; an embedder should not use it.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::cache::{
+        LEAF_CAPACITY, MAX_DEPTH, MAX_SAMPLES, NODE_BYTES, SAMPLE_BYTES, exhaustive_edge_aware,
+        exhaustive_local_global, exhaustive_sum, exhaustive_sum_lanes,
+    };
+    pub use crate::dipole::{
+        AlbedoInverter, MAX_ETA, NodeMoments, UnitDipole, albedo_from_total_reflectance,
+        boundary_term, total_reflectance,
+    };
+    pub use crate::kernel::Kernel;
+    #[cfg(feature = "simd")]
+    pub use crate::lanes::SimdLanes;
+    pub use crate::lanes::{DefaultLanes, LANES, Lanes, Mask, ScalarLanes};
+    pub use crate::morton::Grid;
+    pub use crate::profile::{KD_MAX, KD_MIN};
+    pub use crate::quadrature::GaussLegendre;
+    pub use crate::refine::{
+        DEFAULT_PER_RING, DEFAULT_RINGS, EDGE_THRESHOLD, MAX_NODES, MAX_PER_RING, MAX_RINGS,
+    };
+    pub use crate::table::{
+        exact_local_integral, local_integral_and_slope_unit, local_integral_slope_unit,
+        local_integral_unit,
+    };
+
+    /// A local term with any α and K, not computed together: for testing the queries against
+    /// the exhaustive oracles at chosen K (the API hands out only K computed for its α).
+    pub fn local_term(alpha: f32, k: glam::Vec3) -> crate::LocalTerm {
+        crate::LocalTerm::new(alpha, k)
+    }
+
+    /// Fresnel reflectance and transmittance (`docs/physics.md` §2).
+    pub mod fresnel {
+        pub use crate::fresnel::*;
+    }
+    /// The libm-backed transcendentals every computation of the core goes through.
+    pub mod math {
+        pub use crate::math::*;
+    }
+    /// Morton codes of quantised positions.
+    pub mod morton {
+        pub use crate::morton::*;
+    }
+}

@@ -61,6 +61,9 @@ fn check_distance(name: &'static str, v: f32) -> Result<(), ParamError> {
 }
 
 impl Profile {
+    /// Largest accepted relative index of refraction η (the constructors reject larger ones).
+    pub const MAX_ETA: f32 = dipole::MAX_ETA;
+
     /// Assembles a profile from three channels with the same η.
     fn from_channels(channels: [Dipole; 3], eta: f32) -> Self {
         let fdr_ext = fresnel::diffuse_reflectance_exact(eta as f64);
@@ -209,6 +212,7 @@ impl Profile {
     }
     /// Rd on eight squared distances, per channel.
     #[inline(always)]
+    #[doc(hidden)]
     pub fn rd_lanes<L: Lanes>(&self, r2: L) -> [L; 3] {
         [
             self.channels[0].rd_lanes(r2),
@@ -219,6 +223,7 @@ impl Profile {
     /// Fourth-order corrected node aggregate per channel (see
     /// [`Dipole::rd_lanes_corrected`]).
     #[inline(always)]
+    #[doc(hidden)]
     pub fn rd_lanes_corrected<L: Lanes>(&self, r2: L, m: &NodeMoments<L>) -> [L; 3] {
         [
             self.channels[0].rd_lanes_corrected(r2, m),

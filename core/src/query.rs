@@ -5,20 +5,24 @@
 //! | [`Method::Hierarchical`] (JB02, §9) | M_o = Σ_cut Rd·E·A |
 //! | [`Method::LocalGlobal`] (LM07, §12) | M_o = E(x)·K + Σ_cut (1 − w)·Rd·E·A |
 //! | [`Method::EdgeAware`] (N10, §13) | M_o = E_loc·K + Σ_cut (1 − w)·Rd·E·A, E_loc the kernel-weighted cache irradiance with x inserted at r = 0 |
-//! | [`Method::EdgeRefined`] (departure from N10, §16) | as N10 where the irradiance within α is uniform; elsewhere local = ∫ w·Rd·E dA′ by a quadrature of E(x′) that the caller evaluates ([`crate::refine`]) |
+//! | [`Method::EdgeRefined`] (departure from N10, §16) | as N10 where the irradiance within α is uniform; elsewhere local = ∫ w·Rd·E dA′ by a quadrature of E(x′) that the caller evaluates ([`crate::LocalQuadrature`]) |
 //! | [`Method::Exhaustive`] (§9) | M_o = Σ_all Rd·E·A |
 
+use alloc::string::String;
 use core::fmt;
+use core::str::FromStr;
 
 use glam::{DVec3, Vec3};
 
 use crate::cache::traverse::{EDGE_AWARE, FLUX_HEADROOM, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
 use crate::cache::{self, IrradianceCache};
+use crate::error::ParseMethodError;
 use crate::kernel::Kernel;
 use crate::lanes::{DefaultLanes, Lanes};
+use crate::local_term::LocalTerm;
 use crate::profile::Profile;
 use crate::refine::EDGE_THRESHOLD;
-use crate::stats::{NoStats, QueryStats, StatsSink};
+use crate::stats::{NoStats, StatsSink};
 
 /// How a query sums the cache.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -31,13 +35,13 @@ pub enum Method {
     /// (soft, faithful shadow edges), computed in the same traversal.
     #[default]
     EdgeAware,
-    /// Every sample, no approximation.
-    Exhaustive,
     /// N10's traversal and result where the samples' irradiance within α is within
-    /// [`crate::refine::EDGE_THRESHOLD`] of E(x); elsewhere the query flags the point
+    /// [`LocalQuadrature::EDGE_THRESHOLD`](crate::LocalQuadrature::EDGE_THRESHOLD) of E(x); elsewhere the query flags the point
     /// ([`Exitance::refine`]) and the caller replaces the local term by a quadrature of the
     /// irradiance over the α-disc ([`crate::LocalQuadrature`], [`Exitance::with_local`]).
     EdgeRefined,
+    /// Every sample, no approximation.
+    Exhaustive,
 }
 
 impl Method {
@@ -46,8 +50,8 @@ impl Method {
         Method::Hierarchical,
         Method::LocalGlobal,
         Method::EdgeAware,
-        Method::Exhaustive,
         Method::EdgeRefined,
+        Method::Exhaustive,
     ];
 
     /// The kebab-case name used by the scene format and the command line.
@@ -56,8 +60,8 @@ impl Method {
             Method::Hierarchical => "hierarchical",
             Method::LocalGlobal => "local-global",
             Method::EdgeAware => "edge-aware",
-            Method::Exhaustive => "exhaustive",
             Method::EdgeRefined => "edge-refined",
+            Method::Exhaustive => "exhaustive",
         }
     }
 
@@ -67,6 +71,27 @@ impl Method {
             self,
             Method::LocalGlobal | Method::EdgeAware | Method::EdgeRefined
         )
+    }
+}
+
+impl fmt::Display for Method {
+    /// The [`Method::name`].
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = ParseMethodError;
+
+    /// The method whose [`Method::name`] is `s` (exactly; the error lists the valid names).
+    fn from_str(s: &str) -> Result<Method, ParseMethodError> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| ParseMethodError {
+                name: String::from(s),
+            })
     }
 }
 
@@ -80,25 +105,28 @@ pub struct QuerySettings {
     /// Relative tolerance for skipping negligible subtrees (0 = never): everything skipped
     /// adds up to at most `cull_tolerance ×` the global sum, per channel.
     pub cull_tolerance: f32,
-    /// The smoothing radius α (scene units) of the split methods; α = k·√Ā, see
-    /// [`IrradianceCache::smoothing_radius`].
-    pub smoothing_radius: f32,
 }
 
 impl Default for QuerySettings {
-    /// Edge-aware, ε = 0.05 (pbrt-v2's default), cull tolerance 1e-4, no smoothing radius yet.
+    /// Edge-aware, ε = 0.05 (pbrt-v2's default), cull tolerance 1e-4.
     fn default() -> Self {
         QuerySettings {
             method: Method::EdgeAware,
             epsilon: 0.05,
             cull_tolerance: 1e-4,
-            smoothing_radius: 0.0,
         }
     }
 }
 
 /// The point being shaded.
+///
+/// ```text
+/// offset  0  position    Vec3 (x, y, z: f32)
+/// offset 12  irradiance  Vec3
+/// size   24
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct ShadingPoint {
     /// Position x (scene units).
     pub position: Vec3,
@@ -107,7 +135,17 @@ pub struct ShadingPoint {
 }
 
 /// A query's result, per RGB channel.
+///
+/// ```text
+/// offset  0  total             Vec3 (x, y, z: f32)
+/// offset 12  local             Vec3
+/// offset 24  global            Vec3
+/// offset 36  local_irradiance  Vec3
+/// offset 48  refine            bool (one byte, then 3 bytes of padding)
+/// size   52
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub struct Exitance {
     /// Radiant exitance M_o = local + global.
     pub total: Vec3,
@@ -125,8 +163,10 @@ pub struct Exitance {
 
 impl Exitance {
     /// The same result with the local term replaced (the edge-refined method's quadrature):
-    /// total = local + global; `local_irradiance` becomes local / K per channel (0 where K is).
-    pub fn with_local(self, local: Vec3, k: Vec3) -> Exitance {
+    /// total = local + global; `local_irradiance` becomes local / K per channel (0 where K is),
+    /// K the one the query was given (`term`).
+    pub fn with_local(self, local: Vec3, term: LocalTerm) -> Exitance {
+        let k = term.k();
         let e = Vec3::select(k.cmpgt(Vec3::ZERO), local / k, Vec3::ZERO);
         Exitance {
             total: local + self.global,
@@ -144,7 +184,7 @@ pub enum QueryError {
     NonFinitePosition,
     /// The irradiance at the shading point is negative, NaN or infinite.
     InvalidIrradiance,
-    /// The local integral K is negative, NaN or infinite.
+    /// The local term's K is negative, NaN or infinite, or its smoothing radius α is.
     InvalidLocalIntegral,
     /// A setting is negative, NaN or infinite.
     InvalidSetting {
@@ -185,7 +225,6 @@ impl QuerySettings {
         for (name, value) in [
             ("epsilon", self.epsilon),
             ("cull_tolerance", self.cull_tolerance),
-            ("smoothing_radius", self.smoothing_radius),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(QueryError::InvalidSetting { name, value });
@@ -198,42 +237,52 @@ impl QuerySettings {
 impl IrradianceCache {
     /// Radiant exitance at `point` for a material with diffusion profile `profile`.
     ///
-    /// `local_integral` is K for the same α as `settings.smoothing_radius` (from a
-    /// [`crate::LocalIntegralTable`], e.g. `table.lookup(profile.mean_free_path())`); it is
-    /// ignored by the unsplit methods. Errors only on non-finite or negative inputs.
+    /// `local` is the split methods' smoothing radius α with the local integral K for it (from
+    /// [`crate::LocalIntegralTable::local_term`], [`crate::LocalIntegralByKd::local_term`] or
+    /// [`LocalTerm::exact`]); the unsplit methods ignore it ([`LocalTerm::NONE`]). Errors only
+    /// on non-finite or negative inputs.
     pub fn query(
         &self,
         profile: &Profile,
         point: &ShadingPoint,
-        local_integral: Vec3,
+        local: LocalTerm,
         settings: &QuerySettings,
     ) -> Result<Exitance, QueryError> {
-        self.query_with::<DefaultLanes, _>(profile, point, local_integral, settings, &mut NoStats)
+        self.query_with::<DefaultLanes, _>(profile, point, local, settings, &mut NoStats)
     }
 
-    /// [`IrradianceCache::query`], counting traversal events into `stats`.
-    pub fn query_with_stats(
+    /// [`IrradianceCache::query`], reporting the traversal's events to `stats` (a
+    /// [`crate::stats::QueryStats`] counts them; a [`crate::stats::NoStats`] makes this
+    /// `query`).
+    #[inline]
+    pub fn query_with_stats<S: StatsSink>(
         &self,
         profile: &Profile,
         point: &ShadingPoint,
-        local_integral: Vec3,
+        local: LocalTerm,
         settings: &QuerySettings,
-        stats: &mut QueryStats,
+        stats: &mut S,
     ) -> Result<Exitance, QueryError> {
-        stats.queries += 1;
-        self.query_with::<DefaultLanes, _>(profile, point, local_integral, settings, stats)
+        stats.query();
+        self.query_with::<DefaultLanes, S>(profile, point, local, settings, stats)
     }
 
-    /// [`IrradianceCache::query`] with an explicit lane type (SIMD or scalar) and statistics
-    /// sink: for benchmarks and for testing the two lane types against each other.
+    /// [`IrradianceCache::query_with_stats`] with an explicit lane type (SIMD or scalar): for
+    /// benchmarks and for testing the two lane types against each other. Not part of the API.
+    #[doc(hidden)]
     pub fn query_with<L: Lanes, S: StatsSink>(
         &self,
         profile: &Profile,
         point: &ShadingPoint,
-        local_integral: Vec3,
+        local: LocalTerm,
         settings: &QuerySettings,
         stats: &mut S,
     ) -> Result<Exitance, QueryError> {
+        let local_integral = local.k();
+        let alpha = local.alpha();
+        if !(alpha.is_finite() && alpha >= 0.0) {
+            return Err(QueryError::InvalidLocalIntegral);
+        }
         if !point.position.is_finite() {
             return Err(QueryError::NonFinitePosition);
         }
@@ -252,7 +301,7 @@ impl IrradianceCache {
         let params = Params {
             epsilon: settings.epsilon,
             cull_tolerance: settings.cull_tolerance,
-            kernel: Kernel::new(settings.smoothing_radius),
+            kernel: Kernel::new(alpha),
             irradiance: point.irradiance,
             rd_scale,
             area_scale,
@@ -351,3 +400,11 @@ fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {
         refine: false,
     }
 }
+
+const _: () = {
+    use core::mem::{offset_of, size_of};
+    assert!(size_of::<ShadingPoint>() == 24 && offset_of!(ShadingPoint, irradiance) == 12);
+    assert!(size_of::<Exitance>() == 52);
+    assert!(offset_of!(Exitance, local) == 12 && offset_of!(Exitance, global) == 24);
+    assert!(offset_of!(Exitance, local_irradiance) == 36 && offset_of!(Exitance, refine) == 48);
+};

@@ -61,6 +61,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::kernel::Kernel;
+use crate::local_term::LocalTerm;
 use crate::math;
 use crate::profile::Profile;
 
@@ -101,9 +102,22 @@ pub struct LocalQuadrature {
 }
 
 impl LocalQuadrature {
+    /// The rings of the edge-refined method (chosen by measurement, see `BENCHMARKS.md`).
+    pub const DEFAULT_RINGS: usize = DEFAULT_RINGS;
+    /// The nodes per ring of the edge-refined method.
+    pub const DEFAULT_PER_RING: usize = DEFAULT_PER_RING;
+    /// The most nodes a quadrature has: the length of the `at_nodes` slice
+    /// [`LocalQuadrature::local_term`] reads at most.
+    pub const MAX_NODES: usize = MAX_NODES;
+    /// The edge test's threshold τ of [`crate::Method::EdgeRefined`]: a point is flagged
+    /// ([`crate::Exitance::refine`]) unless every sample within α has its irradiance (summed
+    /// over the channels) in [(1 − τ)·E(x), E(x)/(1 − τ)].
+    pub const EDGE_THRESHOLD: f32 = EDGE_THRESHOLD;
+
     /// The quadrature for `profile` and smoothing radius `alpha` with `rings` radii and
     /// `per_ring` angles (each clamped to 1 ..= its maximum, and rings·per_ring to
-    /// [`MAX_NODES`] by reducing the rings). α = 0 or non-finite gives one node at x.
+    /// [`LocalQuadrature::MAX_NODES`] by reducing the rings). α = 0 or non-finite gives one
+    /// node at x.
     pub fn new(profile: &Profile, alpha: f32, rings: usize, per_ring: usize) -> Self {
         let per_ring = per_ring.clamp(1, MAX_PER_RING);
         let rings = rings.clamp(1, MAX_RINGS).min(MAX_NODES / per_ring);
@@ -190,8 +204,10 @@ impl LocalQuadrature {
     }
 
     /// The local term K·(E(x) + Σ fᵢ·(E(x′ᵢ) − E(x))) from the irradiance `at_nodes` (node
-    /// order; missing nodes count as E(x)). Equal to E(x)·K exactly where every node sees E(x).
-    pub fn local_term(&self, e_x: Vec3, k: Vec3, at_nodes: &[Vec3]) -> Vec3 {
+    /// order; missing nodes count as E(x)), K that of `term` (the query's, for this
+    /// quadrature's α). Equal to E(x)·K exactly where every node sees E(x).
+    pub fn local_term(&self, e_x: Vec3, term: LocalTerm, at_nodes: &[Vec3]) -> Vec3 {
+        let k = term.k();
         let mut sum = Vec3::ZERO;
         for (n, e) in at_nodes.iter().enumerate().take(self.len()) {
             sum += self.fraction(n) * (*e - e_x);
@@ -304,10 +320,11 @@ mod tests {
                 assert!((sum - Vec3::ONE).abs().max_element() < 1e-5, "Σf = {sum}");
                 let e = Vec3::new(2.0, 0.7, 1e-3);
                 let k = Vec3::new(0.3, 0.2, 0.1);
+                let term = LocalTerm::new(alpha, k);
                 let nodes = [e; MAX_NODES];
-                assert_eq!(q.local_term(e, k, &nodes[..q.len()]), e * k);
+                assert_eq!(q.local_term(e, term, &nodes[..q.len()]), e * k);
                 // Every node dark: the local term vanishes (to rounding of Σf).
-                let dark = q.local_term(e, k, &[Vec3::ZERO; MAX_NODES]);
+                let dark = q.local_term(e, term, &[Vec3::ZERO; MAX_NODES]);
                 assert!(dark.max_element() <= 1e-5 * (e * k).max_element(), "{dark}");
                 // Nodes inside the disc, rings in increasing radius.
                 for n in 0..q.len() {

@@ -4,6 +4,9 @@
 
 /// Receives traversal events.
 pub trait StatsSink {
+    /// A query began ([`crate::IrradianceCache::query_with_stats`]).
+    #[inline(always)]
+    fn query(&mut self) {}
     /// An internal node was opened (its up-to-8 children examined in one batch).
     #[inline(always)]
     fn node(&mut self) {}
@@ -47,6 +50,10 @@ impl QueryStats {
 }
 
 impl StatsSink for QueryStats {
+    #[inline(always)]
+    fn query(&mut self) {
+        self.queries += 1;
+    }
     #[inline(always)]
     fn node(&mut self) {
         self.nodes_opened += 1;

@@ -71,6 +71,7 @@ use glam::Vec3;
 use crate::dipole::UnitDipole;
 use crate::error::ParamError;
 use crate::kernel::Kernel;
+use crate::local_term::LocalTerm;
 use crate::math;
 use crate::profile::Profile;
 use crate::quadrature::GaussLegendre;
@@ -426,6 +427,19 @@ impl LocalIntegralTable {
                 self.lookup_channel(2, ell_u.z),
             )
         }
+    }
+
+    /// [`LocalIntegralTable::lookup`] bound to this table's α: the local term of a query
+    /// ([`crate::IrradianceCache::query`]) at a point whose mean free path is `ell_u`.
+    #[inline]
+    pub fn local_term(&self, ell_u: Vec3) -> LocalTerm {
+        LocalTerm::new(self.alpha, self.lookup(ell_u))
+    }
+
+    /// [`LocalIntegralTable::exact_or_limit`] bound to this table's α: the local term of a
+    /// material whose ℓ_u does not vary, computed once per object.
+    pub fn exact_local_term(&self, ell_u: Vec3) -> LocalTerm {
+        LocalTerm::new(self.alpha, self.exact_or_limit(ell_u))
     }
 
     /// [`LocalIntegralTable::lookup`] for one channel.

@@ -4,20 +4,20 @@
 //!
 //! Texture-mapped ℓ with constant K_d is N10's case: α′ is fixed, so one
 //! [`LocalIntegralTable`] (cached at powers of two of ℓ) serves every point. A texture-mapped
-//! K_d also varies α′; K then comes from tables at `KD_LEVELS + 1` evenly spaced K_d values,
-//! built on first use and interpolated linearly in K_d per channel.
+//! K_d also varies α′; K then comes from the core's [`LocalIntegralByKd`], tables at evenly
+//! spaced K_d interpolated linearly in K_d per channel.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use lucent_core::dipole::AlbedoInverter;
-use lucent_core::{Distance as CoreDistance, LocalIntegralTable, ParamError, Profile, presets};
+use lucent_core::error::ParamError;
+use lucent_core::internals::AlbedoInverter;
+use lucent_core::{
+    Distance as CoreDistance, LocalIntegralByKd, LocalIntegralTable, LocalTerm, Profile, presets,
+};
 
 use crate::scene::{ColorParam, Distance, Material, Medium, ScalarParam, Specular};
 use crate::texture::Texture;
-
-/// K_d levels of the tables behind a texture-mapped K_d.
-const KD_LEVELS: usize = 64;
 
 /// A material ready for shading.
 #[derive(Debug)]
@@ -293,7 +293,7 @@ impl TranslucentShader {
     }
 
     /// The local-integral source for smoothing radius `alpha` and threshold `ell_min`.
-    pub fn local_term(&self, alpha: f32, ell_min: f32) -> Result<LocalTerm, ParamError> {
+    pub fn local_term(&self, alpha: f32, ell_min: f32) -> Result<LocalIntegral, ParamError> {
         let textured_kd = matches!(
             &self.params,
             Params::Reflectance {
@@ -303,14 +303,11 @@ impl TranslucentShader {
         );
         if textured_kd {
             let eta = self.base_profile().eta();
-            Ok(LocalTerm::Levels {
-                levels: (0..=KD_LEVELS).map(|_| OnceLock::new()).collect(),
-                alpha,
-                ell_min,
-                eta,
-            })
+            Ok(LocalIntegral::ByKd(LocalIntegralByKd::new(
+                eta, alpha, ell_min,
+            )?))
         } else {
-            Ok(LocalTerm::Single(LocalIntegralTable::new(
+            Ok(LocalIntegral::Single(LocalIntegralTable::new(
                 self.base_profile(),
                 alpha,
                 ell_min,
@@ -321,73 +318,35 @@ impl TranslucentShader {
 
 /// Where K comes from for one material.
 #[derive(Debug)]
-pub enum LocalTerm {
+pub enum LocalIntegral {
     /// Constant K_d: one table over ℓ.
     Single(LocalIntegralTable),
-    /// Texture-mapped K_d: tables at evenly spaced K_d, built on first use.
-    Levels {
-        /// `levels[i]` is the table for K_d = i / KD_LEVELS (clamped into (0, 1)).
-        levels: Vec<OnceLock<LocalIntegralTable>>,
-        /// Smoothing radius.
-        alpha: f32,
-        /// ℓ_min.
-        ell_min: f32,
-        /// Relative index of refraction.
-        eta: f32,
-    },
+    /// Texture-mapped K_d: tables at evenly spaced K_d.
+    ByKd(LocalIntegralByKd),
 }
 
-impl LocalTerm {
-    /// K at a surface point of a material that does not vary over the surface, by quadrature
-    /// (no interpolation error: one quadrature per channel, so once per object, not per
-    /// point). As [`LocalTerm::lookup`], ℓ_u ≤ ℓ_min gives the limit Rd_total.
-    pub fn exact(&self, point: &PointMaterial) -> Vec3 {
+impl LocalIntegral {
+    /// The local term at a surface point of a material that does not vary over the surface,
+    /// by quadrature (no interpolation error: one quadrature per channel, so once per object,
+    /// not per point). As [`LocalIntegral::lookup`], ℓ_u ≤ ℓ_min gives the limit Rd_total.
+    pub fn exact(&self, point: &PointMaterial) -> LocalTerm {
         match self {
-            LocalTerm::Single(table) => table.exact_or_limit(point.profile.mean_free_path()),
-            LocalTerm::Levels { alpha, ell_min, .. } => {
-                LocalIntegralTable::new(&point.profile, *alpha, *ell_min)
-                    .map(|t| t.exact_or_limit(point.profile.mean_free_path()))
+            LocalIntegral::Single(table) => table.exact_local_term(point.profile.mean_free_path()),
+            LocalIntegral::ByKd(tables) => {
+                LocalIntegralTable::new(&point.profile, tables.alpha(), tables.ell_min())
+                    .map(|t| t.exact_local_term(point.profile.mean_free_path()))
                     .unwrap_or_else(|_| self.lookup(point))
             }
         }
     }
 
-    /// K at a surface point.
-    pub fn lookup(&self, point: &PointMaterial) -> Vec3 {
+    /// The local term at a surface point.
+    pub fn lookup(&self, point: &PointMaterial) -> LocalTerm {
         let ell = point.profile.mean_free_path();
         match self {
-            LocalTerm::Single(table) => table.lookup(ell),
-            LocalTerm::Levels {
-                levels,
-                alpha,
-                ell_min,
-                eta,
-            } => {
-                let kd = point.kd.unwrap_or(Vec3::splat(0.5));
-                let table = |i: usize| {
-                    levels[i].get_or_init(|| {
-                        let v = (i as f32 / KD_LEVELS as f32).clamp(0.001, 0.999);
-                        // Both validated at construction: K_d in (0, 1), α > 0, ℓ_min ≥ 0.
-                        let p = Profile::from_reflectance(
-                            Vec3::splat(v),
-                            CoreDistance::MeanFreePath(Vec3::ONE),
-                            *eta,
-                        )
-                        .expect("K_d level in (0, 1)");
-                        LocalIntegralTable::new(&p, *alpha, *ell_min)
-                            .expect("validated smoothing radius")
-                    })
-                };
-                let mut k = Vec3::ZERO;
-                for c in 0..3 {
-                    let x = kd[c].clamp(0.0, 1.0) * KD_LEVELS as f32;
-                    let i = (x as usize).min(KD_LEVELS - 1);
-                    let t = x - i as f32;
-                    let lo = table(i).lookup_channel(c, ell[c]);
-                    let hi = table(i + 1).lookup_channel(c, ell[c]);
-                    k[c] = lo + (hi - lo) * t;
-                }
-                k
+            LocalIntegral::Single(table) => table.local_term(ell),
+            LocalIntegral::ByKd(tables) => {
+                tables.local_term(point.kd.unwrap_or(Vec3::splat(0.5)), ell)
             }
         }
     }
@@ -467,44 +426,38 @@ mod tests {
         // K from the single table equals the table's own lookup at that ℓ.
         let term = shader.local_term(0.1, 1e-4).unwrap();
         let point = shader.at(Vec2::new(0.75, 0.5)).unwrap();
-        let LocalTerm::Single(table) = &term else {
+        let LocalIntegral::Single(table) = &term else {
             panic!("expected a single table")
         };
         assert_eq!(
             term.lookup(&point),
-            table.lookup(point.profile.mean_free_path())
+            table.local_term(point.profile.mean_free_path())
         );
     }
 
+    /// A texture-mapped K_d takes K from the core's tables over K_d at the texel's K_d (their
+    /// interpolation error is tested in the core, `kd_tables.rs`).
     #[test]
-    fn textured_reflectance_interpolates_tables_between_levels() {
-        let tex = texture(&[Vec3::new(0.3, 0.55, 0.9)], 1);
+    fn textured_reflectance_takes_k_from_the_tables_over_kd() {
+        let kd = Vec3::new(0.3, 0.55, 0.9);
+        let tex = texture(&[kd], 1);
         let shader = translucent(Medium::Reflectance {
             kd: ColorParam::Texture(tex),
             distance: Distance::MeanFreePath(ScalarParam::Constant(Vec3::splat(0.05))),
             eta: 1.4,
         });
         let point = shader.at(Vec2::splat(0.5)).unwrap();
-        assert!(
-            (point.profile.total_reflectance() - Vec3::new(0.3, 0.55, 0.9))
-                .abs()
-                .max_element()
-                < 1e-4
-        );
+        assert!((point.profile.total_reflectance() - kd).abs().max_element() < 1e-4);
         let alpha = 0.07;
-        let k = shader
+        let term = shader
             .local_term(alpha, alpha / 1024.0)
             .unwrap()
             .lookup(&point);
-        // Against a table built for exactly this material, looked up at the same ℓ (the ℓ
-        // interpolation is common to both; this isolates the interpolation between K_d levels).
-        let own = LocalIntegralTable::new(&point.profile, alpha, alpha / 1024.0)
+        let want = LocalIntegralByKd::new(1.4, alpha, alpha / 1024.0)
             .unwrap()
-            .lookup(point.profile.mean_free_path());
-        assert!(
-            ((k - own) / own).abs().max_element() < 0.002,
-            "{k} vs {own}"
-        );
+            .local_term(kd, point.profile.mean_free_path());
+        assert_eq!(term, want);
+        assert_eq!(term.alpha(), alpha);
     }
 
     #[test]

@@ -93,15 +93,14 @@ pub extern "C" fn lucent_proof_query(x: f32, y: f32) -> f32 {
         position: Vec3::new(x, y, 0.0),
         irradiance: Vec3::ONE,
     };
-    let k = table.lookup(profile.mean_free_path());
+    let local = table.local_term(profile.mean_free_path());
     let mut result = -1.0;
     for method in Method::ALL {
         let settings = QuerySettings {
             method,
-            smoothing_radius: alpha,
             ..QuerySettings::default()
         };
-        match cache.query(&profile, &point, k, &settings) {
+        match cache.query(&profile, &point, local, &settings) {
             Ok(m) => result = m.total.x,
             Err(_) => return -1.0,
         }

@@ -70,7 +70,15 @@ pub(crate) const LEAF_BIT: u32 = 1 << 31;
 pub(crate) const COUNT_MASK: u32 = 0xf;
 
 /// One irradiance sample: a patch of surface with its area and the irradiance arriving there.
+///
+/// ```text
+/// offset  0  position    Vec3 (x, y, z: f32)
+/// offset 12  area        f32
+/// offset 16  irradiance  Vec3
+/// size   28
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Sample {
     /// Position (scene units).
     pub position: Vec3,
@@ -142,6 +150,11 @@ pub const NODE_BYTES: usize = 14 * core::mem::size_of::<f32>() + 2 * core::mem::
 /// Every f32 node column, by name (for construction, validation and memory accounting).
 pub(crate) const NODE_FLOAT_COLUMNS: usize = 14;
 const _: () = assert!(SAMPLE_BYTES == 28 && NODE_BYTES == 64);
+const _: () = {
+    use core::mem::{offset_of, size_of};
+    assert!(size_of::<Sample>() == 28);
+    assert!(offset_of!(Sample, area) == 12 && offset_of!(Sample, irradiance) == 16);
+};
 
 /// A built irradiance cache: immutable, `Send + Sync`, queried from any number of threads.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,9 +1,10 @@
 //! Building the irradiance cache: invariants (`validate`), determinism, degenerate inputs,
 //! errors, and memory per sample.
 
-use lucent_core::cache::{LEAF_CAPACITY, MAX_DEPTH};
+use lucent_core::error::BuildError;
 use lucent_core::glam::Vec3;
-use lucent_core::{BuildError, IrradianceCache, Sample};
+use lucent_core::internals::{LEAF_CAPACITY, MAX_DEPTH};
+use lucent_core::{IrradianceCache, Sample};
 
 use crate::common::{Rng, box_samples, sphere_samples};
 

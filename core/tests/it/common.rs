@@ -1,7 +1,12 @@
 //! Shared helpers for the core's integration tests: a seeded generator and sample sets.
 
-use lucent_core::Sample;
 use lucent_core::glam::Vec3;
+use lucent_core::{LocalTerm, Sample};
+
+/// A local term with α and K chosen independently (the oracles take them apart).
+pub fn term(alpha: f32, k: Vec3) -> LocalTerm {
+    lucent_core::internals::local_term(alpha, k)
+}
 
 /// SplitMix64: tiny, seeded, good enough for test data.
 pub struct Rng(pub u64);

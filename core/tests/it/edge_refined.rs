@@ -4,10 +4,14 @@
 //! bit, flagged ones edge-aware's global sum.
 
 use lucent_core::glam::Vec3;
-use lucent_core::refine::EDGE_THRESHOLD;
 use lucent_core::{
-    Distance, IrradianceCache, Method, Profile, QuerySettings, Sample, ShadingPoint,
+    Distance, IrradianceCache, LocalQuadrature, Method, Profile, QuerySettings, Sample,
+    ShadingPoint,
 };
+
+use crate::common::term;
+
+const EDGE_THRESHOLD: f32 = LocalQuadrature::EDGE_THRESHOLD;
 
 fn profile() -> Profile {
     Profile::from_reflectance(
@@ -70,10 +74,9 @@ fn the_edge_test_matches_brute_force_and_falls_back_to_edge_aware() {
             let query = |method| {
                 let s = QuerySettings {
                     method,
-                    smoothing_radius: alpha,
                     ..QuerySettings::default()
                 };
-                cache.query(&p, &point, k, &s).unwrap()
+                cache.query(&p, &point, term(alpha, k), &s).unwrap()
             };
             let aware = query(Method::EdgeAware);
             let refined = query(Method::EdgeRefined);
@@ -104,7 +107,7 @@ fn the_edge_test_matches_brute_force_and_falls_back_to_edge_aware() {
                 assert_eq!(refined, aware, "x {x}");
             }
             // Replacing the local term keeps the global sum and adds up.
-            let r = refined.with_local(e * k, k);
+            let r = refined.with_local(e * k, term(alpha, k));
             assert_eq!(r.total, e * k + aware.global);
             assert_eq!(r.local_irradiance, e);
         }

@@ -29,7 +29,9 @@
 //! `bias_table` (ignored) prints every figure.
 
 use lucent_core::glam::{DVec3, Vec3};
-use lucent_core::{IrradianceCache, Method, Profile, QuerySettings, Sample, ShadingPoint};
+use lucent_core::{
+    IrradianceCache, LocalTerm, Method, Profile, QuerySettings, Sample, ShadingPoint,
+};
 
 use crate::common::Rng;
 
@@ -103,9 +105,11 @@ fn bias(
                 method,
                 epsilon,
                 cull_tolerance: tol,
-                smoothing_radius: 0.0,
             };
-            cache.query(profile, &sp, Vec3::ZERO, &s).unwrap().total
+            cache
+                .query(profile, &sp, LocalTerm::NONE, &s)
+                .unwrap()
+                .total
         };
         let (got, want) = (q(Method::Hierarchical, eps), q(Method::Exhaustive, 0.0));
         h += got.as_dvec3();

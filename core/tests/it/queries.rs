@@ -2,15 +2,17 @@
 //! error in ε, the split methods vs their every-sample formulas, SIMD vs scalar lanes, cull
 //! tolerance, determinism, and the properties every result must have.
 
-use lucent_core::cache::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
+use lucent_core::error::QueryError;
 use lucent_core::glam::Vec3;
-use lucent_core::lanes::ScalarLanes;
+use lucent_core::internals::ScalarLanes;
+use lucent_core::internals::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
+use lucent_core::stats::{NoStats, QueryStats};
 use lucent_core::{
-    Distance, IrradianceCache, LocalIntegralTable, Method, NoStats, Profile, QueryError,
-    QuerySettings, QueryStats, ShadingPoint,
+    Distance, IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, QuerySettings,
+    ShadingPoint,
 };
 
-use crate::common::{Rng, box_samples, rel_err, sphere_samples};
+use crate::common::{Rng, box_samples, rel_err, sphere_samples, term};
 
 fn profile(ell: f32) -> Profile {
     Profile::from_reflectance(
@@ -36,12 +38,11 @@ fn query_points(n: usize, seed: u64) -> Vec<Vec3> {
         .collect()
 }
 
-fn settings(method: Method, epsilon: f32, cull: f32, alpha: f32) -> QuerySettings {
+fn settings(method: Method, epsilon: f32, cull: f32) -> QuerySettings {
     QuerySettings {
         method,
         epsilon,
         cull_tolerance: cull,
-        smoothing_radius: alpha,
     }
 }
 
@@ -67,7 +68,12 @@ fn epsilon_zero_is_the_exhaustive_sum() {
         let want = exhaustive_sum(&cache, &p, x);
         for method in [Method::Hierarchical, Method::Exhaustive] {
             let got = cache
-                .query(&p, &point(x), Vec3::ZERO, &settings(method, 0.0, 0.0, 0.0))
+                .query(
+                    &p,
+                    &point(x),
+                    term(0.0, Vec3::ZERO),
+                    &settings(method, 0.0, 0.0),
+                )
                 .unwrap();
             assert!(
                 rel_err(got.total, want) < 2e-5,
@@ -102,11 +108,14 @@ fn hierarchical_error_shrinks_with_epsilon() {
         (0.01, 5e-6),
         (0.001, 2e-7),
     ] {
-        let s = settings(Method::Hierarchical, epsilon, 0.0, 0.0);
+        let s = settings(Method::Hierarchical, epsilon, 0.0);
         let mut mean = 0.0;
         let mut worst = 0.0_f32;
         for (x, want) in points.iter().zip(&truth) {
-            let got = cache.query(&p, &point(*x), Vec3::ZERO, &s).unwrap().total;
+            let got = cache
+                .query(&p, &point(*x), term(0.0, Vec3::ZERO), &s)
+                .unwrap()
+                .total;
             let e = (got - *want).abs().max_element() / scale;
             mean += e / points.len() as f32;
             worst = worst.max(e);
@@ -145,7 +154,7 @@ fn split_methods_match_brute_force_oracles() {
             let ea = exhaustive_edge_aware(&cache, &p, x, sp.irradiance, kk, alpha);
             for (method, want) in [(Method::LocalGlobal, lg), (Method::EdgeAware, ea)] {
                 let exact = cache
-                    .query(&p, &sp, kk, &settings(method, 0.0, 0.0, alpha))
+                    .query(&p, &sp, term(alpha, kk), &settings(method, 0.0, 0.0))
                     .unwrap();
                 assert!(
                     rel_err(exact.total, want) < 1e-4,
@@ -159,7 +168,7 @@ fn split_methods_match_brute_force_oracles() {
                         <= 1e-6 * exact.total.max_element()
                 );
                 let approx = cache
-                    .query(&p, &sp, kk, &settings(method, 0.05, 0.0, alpha))
+                    .query(&p, &sp, term(alpha, kk), &settings(method, 0.05, 0.0))
                     .unwrap();
                 assert!(
                     err(approx.total, want) < 0.02,
@@ -183,11 +192,11 @@ fn simd_and_scalar_lanes_agree() {
         .lookup(p.mean_free_path());
     for x in query_points(100, 8) {
         for method in Method::ALL {
-            let s = settings(method, 0.05, 1e-4, alpha);
+            let s = settings(method, 0.05, 1e-4);
             let a = cache
-                .query_with::<ScalarLanes, _>(&p, &point(x), kk, &s, &mut NoStats)
+                .query_with::<ScalarLanes, _>(&p, &point(x), term(alpha, kk), &s, &mut NoStats)
                 .unwrap();
-            let b = cache.query(&p, &point(x), kk, &s).unwrap();
+            let b = cache.query(&p, &point(x), term(alpha, kk), &s).unwrap();
             assert!(
                 err(a.total, b.total) < 1e-5,
                 "{method:?} at {x}: scalar {} simd {}",
@@ -203,14 +212,14 @@ fn queries_are_deterministic_across_threads() {
     let cache = IrradianceCache::build(&sphere_samples(5000, 1.0, 9)).unwrap();
     let p = profile(0.05);
     let alpha = cache.smoothing_radius(1.5);
-    let s = settings(Method::EdgeAware, 0.05, 1e-4, alpha);
+    let s = settings(Method::EdgeAware, 0.05, 1e-4);
     let points = query_points(200, 10);
     let run = || {
         points
             .iter()
             .map(|&x| {
                 cache
-                    .query(&p, &point(x), Vec3::splat(0.2), &s)
+                    .query(&p, &point(x), term(alpha, Vec3::splat(0.2)), &s)
                     .unwrap()
                     .total
             })
@@ -259,9 +268,9 @@ fn results_are_finite_non_negative_and_linear_in_irradiance() {
     far.extend([Vec3::ZERO, Vec3::splat(1e6), Vec3::new(-1e30, 0.0, 1e30)]);
     for x in far {
         for method in Method::ALL {
-            let s = settings(method, 0.05, 1e-4, alpha);
+            let s = settings(method, 0.05, 1e-4);
             let sp = point(x);
-            let m1 = cache.query(&p, &sp, kk, &s).unwrap();
+            let m1 = cache.query(&p, &sp, term(alpha, kk), &s).unwrap();
             for v in [m1.total, m1.local, m1.global, m1.local_irradiance] {
                 assert!(
                     v.is_finite() && v.min_element() >= 0.0,
@@ -274,7 +283,7 @@ fn results_are_finite_non_negative_and_linear_in_irradiance() {
                 irradiance: sp.irradiance * 2.0,
                 ..sp
             };
-            let m2 = cache2.query(&p, &sp2, kk, &s).unwrap();
+            let m2 = cache2.query(&p, &sp2, term(alpha, kk), &s).unwrap();
             let diff = (m2.total - m1.total * 2.0).abs().max_element();
             assert!(
                 diff <= 1e-37 || diff == 0.0,
@@ -286,7 +295,7 @@ fn results_are_finite_non_negative_and_linear_in_irradiance() {
                 irradiance: sp.irradiance * 3.0,
                 ..sp
             };
-            let m3 = cache3.query(&p, &sp3, kk, &s).unwrap();
+            let m3 = cache3.query(&p, &sp3, term(alpha, kk), &s).unwrap();
             assert!(err(m3.total, m1.total * 3.0) < 1e-5, "{method:?} at {x}");
         }
     }
@@ -309,8 +318,8 @@ fn cull_tolerance_bounds_the_skipped_contribution() {
                         .query(
                             &p,
                             &point(x),
-                            Vec3::ZERO,
-                            &settings(Method::Hierarchical, epsilon, 0.0, 0.0),
+                            term(0.0, Vec3::ZERO),
+                            &settings(Method::Hierarchical, epsilon, 0.0),
                         )
                         .unwrap()
                         .total
@@ -318,11 +327,11 @@ fn cull_tolerance_bounds_the_skipped_contribution() {
                 .collect();
             let mut last_work = u64::MAX;
             for tolerance in [0.0, 1e-4, 1e-3, 1e-2] {
-                let s = settings(Method::Hierarchical, epsilon, tolerance, 0.0);
+                let s = settings(Method::Hierarchical, epsilon, tolerance);
                 let mut stats = QueryStats::default();
                 for (x, m0) in points.iter().zip(&full) {
                     let m = cache
-                        .query_with_stats(&p, &point(*x), Vec3::ZERO, &s, &mut stats)
+                        .query_with_stats(&p, &point(*x), term(0.0, Vec3::ZERO), &s, &mut stats)
                         .unwrap()
                         .total;
                     let skipped = *m0 - m;
@@ -362,8 +371,8 @@ fn stats_count_the_work() {
         .query_with_stats(
             &p,
             &point(Vec3::ZERO),
-            Vec3::ZERO,
-            &settings(Method::Hierarchical, 0.0, 0.0, 0.0),
+            term(0.0, Vec3::ZERO),
+            &settings(Method::Hierarchical, 0.0, 0.0),
             &mut stats,
         )
         .unwrap();
@@ -376,8 +385,8 @@ fn stats_count_the_work() {
         .query_with_stats(
             &p,
             &point(Vec3::splat(50.0)),
-            Vec3::ZERO,
-            &settings(Method::Hierarchical, 0.05, 0.0, 0.0),
+            term(0.0, Vec3::ZERO),
+            &settings(Method::Hierarchical, 0.05, 0.0),
             &mut stats,
         )
         .unwrap();
@@ -394,7 +403,7 @@ fn invalid_query_inputs_are_errors() {
     let s = QuerySettings::default();
     let ok = point(Vec3::ZERO);
     assert_eq!(
-        cache.query(&p, &point(Vec3::NAN), Vec3::ZERO, &s),
+        cache.query(&p, &point(Vec3::NAN), LocalTerm::NONE, &s),
         Err(QueryError::NonFinitePosition)
     );
     let bad_e = ShadingPoint {
@@ -402,11 +411,11 @@ fn invalid_query_inputs_are_errors() {
         ..ok
     };
     assert_eq!(
-        cache.query(&p, &bad_e, Vec3::ZERO, &s),
+        cache.query(&p, &bad_e, LocalTerm::NONE, &s),
         Err(QueryError::InvalidIrradiance)
     );
     assert_eq!(
-        cache.query(&p, &ok, Vec3::splat(f32::NAN), &s),
+        cache.query(&p, &ok, term(0.1, Vec3::splat(f32::NAN)), &s),
         Err(QueryError::InvalidLocalIntegral)
     );
     let bad_s = QuerySettings {
@@ -414,26 +423,28 @@ fn invalid_query_inputs_are_errors() {
         ..s
     };
     assert!(matches!(
-        cache.query(&p, &ok, Vec3::ZERO, &bad_s),
+        cache.query(&p, &ok, LocalTerm::NONE, &bad_s),
         Err(QueryError::InvalidSetting {
             name: "epsilon",
             ..
         })
     ));
-    let bad_s = QuerySettings {
-        smoothing_radius: -1.0,
-        ..s
-    };
-    assert!(cache.query(&p, &ok, Vec3::ZERO, &bad_s).is_err());
+    for alpha in [-1.0, f32::NAN, f32::INFINITY] {
+        assert_eq!(
+            cache.query(&p, &ok, term(alpha, Vec3::ZERO), &s),
+            Err(QueryError::InvalidLocalIntegral),
+            "α {alpha}"
+        );
+    }
 }
 
 #[test]
 fn empty_and_single_sample_caches() {
     let p = profile(0.1);
     let empty = IrradianceCache::build(&[]).unwrap();
-    let s = settings(Method::EdgeAware, 0.05, 1e-4, 0.1);
+    let s = settings(Method::EdgeAware, 0.05, 1e-4);
     let m = empty
-        .query(&p, &point(Vec3::ZERO), Vec3::splat(0.5), &s)
+        .query(&p, &point(Vec3::ZERO), term(0.1, Vec3::splat(0.5)), &s)
         .unwrap();
     assert_eq!(m.global, Vec3::ZERO);
     assert!(m.total.is_finite());
@@ -444,8 +455,8 @@ fn empty_and_single_sample_caches() {
             .query(
                 &p,
                 &point(Vec3::splat(0.1)),
-                Vec3::splat(0.5),
-                &settings(method, 0.05, 1e-4, 0.1),
+                term(0.1, Vec3::splat(0.5)),
+                &settings(method, 0.05, 1e-4),
             )
             .unwrap();
         assert!(m.total.is_finite() && m.total.min_element() >= 0.0);
@@ -467,7 +478,7 @@ fn edge_aware_local_irradiance_stays_accurate_when_its_weights_are_tiny() {
         "the test needs subnormal weights, got {centre}"
     );
     let alpha = cache.smoothing_radius(3.0);
-    let kernel = lucent_core::Kernel::new(alpha);
+    let kernel = lucent_core::internals::Kernel::new(alpha);
     let kk = LocalIntegralTable::new(&p, alpha, 0.0)
         .unwrap()
         .lookup(p.mean_free_path());
@@ -488,7 +499,12 @@ fn edge_aware_local_irradiance_stays_accurate_when_its_weights_are_tiny() {
             irradiance: e,
         };
         let got = cache
-            .query(&p, &sp, kk, &settings(Method::EdgeAware, 0.0, 0.0, alpha))
+            .query(
+                &p,
+                &sp,
+                term(alpha, kk),
+                &settings(Method::EdgeAware, 0.0, 0.0),
+            )
             .unwrap();
         assert!(got.total.is_finite());
         let error =
@@ -536,7 +552,7 @@ fn assert_edge_aware_matches_f64(
     cache.validate().unwrap();
     let centre = p.rd_zero().as_dvec3() * cache.mean_area() as f64;
     let alpha = cache.smoothing_radius(k);
-    let kernel = lucent_core::Kernel::new(alpha);
+    let kernel = lucent_core::internals::Kernel::new(alpha);
     let kk = LocalIntegralTable::new(p, alpha, 0.0)
         .unwrap()
         .lookup(p.mean_free_path());
@@ -551,7 +567,12 @@ fn assert_edge_aware_matches_f64(
         }
         let want = (num / den).as_vec3();
         let got = cache
-            .query(p, sp, kk, &settings(Method::EdgeAware, 0.0, 0.0, alpha))
+            .query(
+                p,
+                sp,
+                term(alpha, kk),
+                &settings(Method::EdgeAware, 0.0, 0.0),
+            )
             .unwrap();
         assert!(got.total.is_finite(), "at {x}: {got:?}");
         let error = rel_err(got.local_irradiance, want);
@@ -675,7 +696,12 @@ fn unlit_surface_failures(spread: f32, trials: usize, seed: u64) -> Vec<(usize, 
                 irradiance: Vec3::ONE,
             };
             let got = cache
-                .query(&p, &sp, kk, &settings(Method::EdgeAware, 0.0, 0.0, alpha))
+                .query(
+                    &p,
+                    &sp,
+                    term(alpha, kk),
+                    &settings(Method::EdgeAware, 0.0, 0.0),
+                )
                 .unwrap();
             // Every other sample is far beyond α: E_loc = Rd(0)·Ā / (Rd(0)·Ā + Rd(0)·A).
             let want = cache.mean_area() / (cache.mean_area() + 1.0);

@@ -21,15 +21,16 @@
 
 use std::time::Instant;
 
-use lucent_core::cache::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
-use lucent_core::dipole::AlbedoInverter;
+use lucent_core::error::{BuildError, ParamError};
 use lucent_core::glam::Vec3;
+use lucent_core::internals::AlbedoInverter;
+use lucent_core::internals::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
 use lucent_core::{
-    BuildError, Distance, IrradianceCache, LocalIntegralTable, Method, ParamError, Profile,
-    QuerySettings, Sample, ShadingPoint,
+    Distance, IrradianceCache, LocalIntegralTable, Method, Profile, QuerySettings, Sample,
+    ShadingPoint,
 };
 
-use crate::common::{Rng, sphere_samples};
+use crate::common::{Rng, sphere_samples, term};
 
 // ---------------------------------------------------------------------------------------------
 // Shared checks
@@ -49,12 +50,11 @@ fn finite_non_negative(v: Vec3) -> bool {
     v.is_finite() && v.min_element() >= 0.0
 }
 
-fn settings(method: Method, epsilon: f32, cull_tolerance: f32, alpha: f32) -> QuerySettings {
+fn settings(method: Method, epsilon: f32, cull_tolerance: f32) -> QuerySettings {
     QuerySettings {
         method,
         epsilon,
         cull_tolerance,
-        smoothing_radius: alpha,
     }
 }
 
@@ -113,9 +113,9 @@ fn check_methods(
     for (p, want) in points.iter().zip(&truth) {
         let at = format!("{what} at {}", p.position);
         assert!(finite_non_negative(*want), "{at}: exhaustive {want}");
-        let q = |s: QuerySettings| {
+        let q = |s: QuerySettings, alpha: f32| {
             let m = cache
-                .query(profile, p, k, &s)
+                .query(profile, p, term(alpha, k), &s)
                 .unwrap_or_else(|e| panic!("{at}: {s:?}: {e}"));
             for v in [m.total, m.local, m.global, m.local_irradiance] {
                 assert!(finite_non_negative(v), "{at}: {s:?}: {m:?}");
@@ -124,14 +124,14 @@ fn check_methods(
         };
 
         // JB02 with ε = 0 and no culling visits every sample: the exhaustive sum.
-        let h = q(settings(Method::Hierarchical, 0.0, 0.0, 0.0)).total;
+        let h = q(settings(Method::Hierarchical, 0.0, 0.0), 0.0).total;
         let e = rel(h, *want, floor);
         assert!(e < 2e-5, "{at}: hierarchical ε=0 {h} vs exhaustive {want}");
         worst.hierarchical = worst.hierarchical.max(e);
 
         // Culling skips non-negative terms worth at most `tolerance ×` the result.
         for tolerance in [1e-4, 1e-2] {
-            let c = q(settings(Method::Hierarchical, 0.0, tolerance, 0.0)).total;
+            let c = q(settings(Method::Hierarchical, 0.0, tolerance), 0.0).total;
             let skipped = h - c;
             let slack = 4e-6 * h.max_element() + 1e-37;
             assert!(
@@ -152,7 +152,7 @@ fn check_methods(
                 exhaustive_edge_aware(cache, profile, p.position, e_x, k, alpha),
             ),
         ] {
-            let m = q(settings(method, 0.0, 0.0, alpha));
+            let m = q(settings(method, 0.0, 0.0), alpha);
             let e = rel(m.total, oracle, floor);
             assert!(
                 e < 1e-4,
@@ -164,7 +164,7 @@ fn check_methods(
 
         // Default settings: finite, and hierarchical/exhaustive close to the truth.
         for method in Method::ALL {
-            let m = q(settings(method, 0.05, 1e-4, alpha));
+            let m = q(settings(method, 0.05, 1e-4), alpha);
             if matches!(method, Method::Hierarchical | Method::Exhaustive) {
                 let e = (m.total - *want).abs().max_element() / scale.max(1e-37);
                 worst.approximate = worst.approximate.max(e);
@@ -543,7 +543,7 @@ fn exitance_is_scale_invariant() {
                 .iter()
                 .map(|q| {
                     cache
-                        .query(&p, q, k, &settings(method, 0.05, 1e-4, alpha))
+                        .query(&p, q, term(alpha, k), &settings(method, 0.05, 1e-4))
                         .unwrap()
                         .total
                 })
@@ -607,7 +607,7 @@ fn coincident_samples() {
             })
             .collect();
         let cache = IrradianceCache::build(&samples).unwrap();
-        assert!(cache.depth() <= lucent_core::cache::MAX_DEPTH);
+        assert!(cache.depth() <= lucent_core::internals::MAX_DEPTH);
         let mut points = points_near(&samples, count / 3, 25);
         points.push(ShadingPoint {
             position: Vec3::ZERO,
@@ -694,8 +694,8 @@ fn one_sample() {
                 .query(
                     &p,
                     &points[points.len() - 1],
-                    Vec3::ZERO,
-                    &settings(Method::Hierarchical, epsilon, 0.0, 0.0),
+                    term(0.0, Vec3::ZERO),
+                    &settings(Method::Hierarchical, epsilon, 0.0),
                 )
                 .unwrap();
             assert!(
@@ -727,8 +727,8 @@ fn one_sample() {
             .query(
                 &p,
                 &points[0],
-                Vec3::splat(0.5),
-                &settings(method, 0.05, 1e-4, 0.1),
+                term(0.1, Vec3::splat(0.5)),
+                &settings(method, 0.05, 1e-4),
             )
             .unwrap();
         assert_eq!(m.global, Vec3::ZERO);
@@ -902,8 +902,8 @@ fn lit_plane_exitance_reaches_the_lambertian_limit() {
         for &ell in &ells {
             let p = profile(kd, Vec3::splat(ell), 1.3);
             let table = LocalIntegralTable::new(&p, alpha, ell_min).unwrap();
-            let k = table.lookup(p.mean_free_path());
-            let s = settings(method, 0.05, 1e-4, alpha);
+            let k = table.local_term(p.mean_free_path());
+            let s = settings(method, 0.05, 1e-4);
             let mut mean = Vec3::ZERO;
             for q in &points {
                 let m = cache.query(&p, q, k, &s).unwrap();
@@ -950,7 +950,7 @@ fn lit_plane_exitance_reaches_the_lambertian_limit() {
         for method in [Method::Hierarchical, Method::Exhaustive] {
             for q in &points {
                 let m = cache
-                    .query(&p, q, Vec3::ZERO, &settings(method, 0.05, 1e-4, 0.0))
+                    .query(&p, q, term(0.0, Vec3::ZERO), &settings(method, 0.05, 1e-4))
                     .unwrap();
                 assert!(finite_non_negative(m.total), "{method:?} ℓ {ell:e}: {m:?}");
             }
@@ -1042,10 +1042,10 @@ fn ten_million_samples() {
     let p = profile(Vec3::new(0.83, 0.79, 0.75), Vec3::splat(0.003), 1.5);
     let alpha = cache.smoothing_radius(1.5);
     let table = LocalIntegralTable::new(&p, alpha, alpha / 1024.0).unwrap();
-    let k = table.lookup(p.mean_free_path());
+    let k = table.local_term(p.mean_free_path());
     let points = points_near(&samples[..20_000], 100, 35);
     for method in Method::ALL {
-        let s = settings(method, 0.05, 1e-4, alpha);
+        let s = settings(method, 0.05, 1e-4);
         let n = if method == Method::Exhaustive {
             4
         } else {
@@ -1073,7 +1073,7 @@ fn ten_million_samples() {
     for q in &points[..3] {
         let want = exhaustive_sum(&cache, &p, q.position);
         let h = cache
-            .query(&p, q, k, &settings(Method::Hierarchical, 0.0, 0.0, 0.0))
+            .query(&p, q, k, &settings(Method::Hierarchical, 0.0, 0.0))
             .unwrap()
             .total;
         let e = rel(h, want, 1e-6 * want.max_element());

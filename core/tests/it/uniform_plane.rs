@@ -73,13 +73,12 @@ fn every_method_reproduces_e_times_rd_total_on_a_lit_plane() {
                     method,
                     epsilon: 0.05,
                     cull_tolerance: 1e-4,
-                    smoothing_radius: alpha,
                 };
                 let m = cache
                     .query(
                         &profile,
                         &point,
-                        table.lookup(profile.mean_free_path()),
+                        table.local_term(profile.mean_free_path()),
                         &settings,
                     )
                     .unwrap();

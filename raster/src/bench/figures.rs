@@ -17,7 +17,7 @@ use crate::output::heatmap::max_pixel_error;
 use crate::output::png::encode_srgb8;
 use crate::output::{ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, error_heatmap};
 use crate::plot::{Chart, Series, Sheet, SheetRow, Tile, crop_magnify, render_chart, render_sheet};
-use crate::scene::SssMethod;
+use lucent_core::Method;
 
 /// Magnification of the shadow-edge insets.
 const INSET_ZOOM: u32 = 3;
@@ -72,7 +72,7 @@ pub fn write_scene_figures(
             .write_png(&out.join(format!("{}-{file}.png", scene.name())))?;
     }
 
-    let pick = |method: SssMethod| {
+    let pick = |method: Method| {
         sheet_images
             .iter()
             .filter(|(s, _)| s.method == method)
@@ -83,10 +83,10 @@ pub fn write_scene_figures(
             .map(|(_, image)| image)
     };
     let (Some(hier), Some(lm), Some(n10), Some(refined)) = (
-        pick(SssMethod::Hierarchical),
-        pick(SssMethod::LocalGlobal),
-        pick(SssMethod::EdgeAware),
-        pick(SssMethod::EdgeRefined),
+        pick(Method::Hierarchical),
+        pick(Method::LocalGlobal),
+        pick(Method::EdgeAware),
+        pick(Method::EdgeRefined),
     ) else {
         return Ok(());
     };

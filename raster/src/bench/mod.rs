@@ -50,7 +50,8 @@ pub use split::TermErrors;
 use crate::output::{ErrorStats, OutputError, RgbImage, compare, write_exr, write_png};
 use crate::plot::PlotError;
 use crate::render::{RenderError, RenderOptions, render};
-use crate::scene::{SceneError, SssMethod, default_scene};
+use crate::scene::{SceneError, default_scene};
+use lucent_core::Method;
 
 /// Why the benchmark stopped.
 #[derive(Debug)]
@@ -100,7 +101,7 @@ pub struct BenchConfig {
     /// Ground-truth density as a multiple of the largest count.
     pub truth_factor: u32,
     /// The ground truth's method (see the module doc).
-    pub truth_method: SssMethod,
+    pub truth_method: Method,
     /// ε of the ground truth's octree sum.
     pub truth_epsilon: f32,
     /// The count of the contact sheets and claims (the talk's 23k).
@@ -132,7 +133,7 @@ impl BenchConfig {
             split_epsilon: 0.5,
             seeds: vec![1, 2, 3],
             truth_factor: 16,
-            truth_method: SssMethod::LocalGlobal,
+            truth_method: Method::LocalGlobal,
             truth_epsilon: 0.02,
             sheet_count: 23_000,
             smoothings: vec![1.0, 1.5, 2.0, 3.0],
@@ -154,7 +155,7 @@ impl BenchConfig {
             split_epsilon: 0.5,
             seeds: vec![1, 2],
             truth_factor: 4,
-            truth_method: SssMethod::LocalGlobal,
+            truth_method: Method::LocalGlobal,
             truth_epsilon: 0.05,
             sheet_count: 8_000,
             smoothings: vec![1.5, 3.0],
@@ -173,15 +174,11 @@ impl BenchConfig {
             .epsilons
             .iter()
             .map(|&epsilon| MethodSetting {
-                method: SssMethod::Hierarchical,
+                method: Method::Hierarchical,
                 epsilon,
             })
             .collect();
-        for method in [
-            SssMethod::LocalGlobal,
-            SssMethod::EdgeAware,
-            SssMethod::EdgeRefined,
-        ] {
+        for method in Method::ALL.into_iter().filter(|m| m.is_split()) {
             s.push(MethodSetting {
                 method,
                 epsilon: self.split_epsilon,
@@ -453,10 +450,7 @@ fn run_scene(
             report.threads = result.threads;
             if count == config.sheet_count {
                 // The error split compares LM07 and N10 (edge-refined is in its own table).
-                if matches!(
-                    setting.method,
-                    SssMethod::LocalGlobal | SssMethod::EdgeAware
-                ) {
+                if matches!(setting.method, Method::LocalGlobal | Method::EdgeAware) {
                     split_runs.push((first.stats.samples, first.pixels));
                 }
                 sheet_images.push((setting, first.image));
@@ -557,10 +551,7 @@ fn smoothing_sweep(
         method,
         epsilon: config.split_epsilon,
     };
-    let (lm, n10) = (
-        setting(SssMethod::LocalGlobal),
-        setting(SssMethod::EdgeAware),
-    );
+    let (lm, n10) = (setting(Method::LocalGlobal), setting(Method::EdgeAware));
     let mut rows = Vec::new();
     for &k in &config.smoothings {
         let (local_global, edge_aware) = if k == base.render.smoothing {
@@ -615,7 +606,7 @@ fn table_check(
     log: &mut dyn FnMut(&str),
 ) -> Result<TableCheck, BenchError> {
     let setting = MethodSetting {
-        method: SssMethod::EdgeAware,
+        method: Method::EdgeAware,
         epsilon: config.split_epsilon,
     };
     let run = report::find(report, BenchScene::Textured, setting, config.sheet_count);
@@ -657,7 +648,7 @@ fn exhaustive_check(
     let seed = config.seeds[0];
     log(&format!("sphere: exhaustive sum, {n} samples"));
     let exhaustive_setting = MethodSetting {
-        method: SssMethod::Exhaustive,
+        method: Method::Exhaustive,
         epsilon: config.split_epsilon,
     };
     let exhaustive = runner::render_once(
@@ -673,7 +664,7 @@ fn exhaustive_check(
     let mut rows = Vec::new();
     for &epsilon in &config.exhaustive_epsilons {
         let setting = MethodSetting {
-            method: SssMethod::Hierarchical,
+            method: Method::Hierarchical,
             epsilon,
         };
         let (r, _) =

@@ -25,7 +25,8 @@ use super::BenchError;
 use super::runner::{MethodSetting, configure, median, render_once};
 use super::scenes::BenchScene;
 use crate::render::bake;
-use crate::scene::{Scene, SssMethod};
+use crate::scene::Scene;
+use lucent_core::Method;
 
 /// The split methods and hierarchical at equal ε, rounds of interleaved renders of one baked sample set.
 #[derive(Clone, Debug)]
@@ -82,11 +83,11 @@ impl Spread {
 }
 
 /// The methods in the order of [`OverheadRow::shading`].
-const METHODS: [SssMethod; 4] = [
-    SssMethod::Hierarchical,
-    SssMethod::LocalGlobal,
-    SssMethod::EdgeAware,
-    SssMethod::EdgeRefined,
+const METHODS: [Method; 4] = [
+    Method::Hierarchical,
+    Method::LocalGlobal,
+    Method::EdgeAware,
+    Method::EdgeRefined,
 ];
 
 /// Measures one scene at `samples` over `rounds` rounds (see the module documentation), at

@@ -8,7 +8,7 @@ use std::path::Path;
 use super::runner::{MethodSetting, RunResult};
 use super::{BenchError, BenchReport, BenchScene, SmoothingRow};
 use crate::output::{OutputError, write_atomically};
-use crate::scene::SssMethod;
+use lucent_core::Method;
 
 /// The well-known C++ implementation's CPU per lookup on the sphere (µs) and its error
 /// against its own exhaustive sum (relative): the figures claim 4 compares with.
@@ -45,7 +45,7 @@ pub fn find(
         .find(|r| r.scene == scene && r.setting == setting && r.samples == samples)
 }
 
-fn split(report: &BenchReport, method: SssMethod) -> MethodSetting {
+fn split(report: &BenchReport, method: Method) -> MethodSetting {
     MethodSetting {
         method,
         epsilon: report.config.split_epsilon,
@@ -153,9 +153,9 @@ fn error_split(report: &BenchReport, s: &mut String) {
 fn claims(report: &BenchReport) -> String {
     let c = &report.config;
     let mut s = String::new();
-    let hier = split(report, SssMethod::Hierarchical);
-    let lm = split(report, SssMethod::LocalGlobal);
-    let n10 = split(report, SssMethod::EdgeAware);
+    let hier = split(report, Method::Hierarchical);
+    let lm = split(report, Method::LocalGlobal);
+    let n10 = split(report, Method::EdgeAware);
 
     let _ = writeln!(
         s,
@@ -351,7 +351,7 @@ pub fn write_markdown(report: &BenchReport, path: &Path) -> Result<(), BenchErro
     let _ = writeln!(
         s,
         "## Ground truth\n\n{}, ε = {}, cull tolerance 1e-6, {}× the largest count (why not the exhaustive sum: `raster/src/bench/mod.rs`); convergence = the half-density truth against it, to be read against the smallest error below.\n\n| scene | samples | render | translucent px | edge-band px | convergence (mean rel.) | RMSE |\n|---|---:|---:|---:|---:|---:|---:|",
-        crate::render::core_method(c.truth_method).name(),
+        c.truth_method.name(),
         c.truth_epsilon,
         c.truth_factor
     );
@@ -411,9 +411,9 @@ pub fn write_markdown(report: &BenchReport, path: &Path) -> Result<(), BenchErro
 /// Edge-refined (a departure from N10) against local-global and edge-aware at every count:
 /// the shadow-edge band's error and the shading phase.
 fn refined_table(report: &BenchReport, s: &mut String) {
-    let lm = split(report, SssMethod::LocalGlobal);
-    let n10 = split(report, SssMethod::EdgeAware);
-    let refined = split(report, SssMethod::EdgeRefined);
+    let lm = split(report, Method::LocalGlobal);
+    let n10 = split(report, Method::EdgeAware);
+    let refined = split(report, Method::EdgeRefined);
     let _ = writeln!(
         s,
         "\nEdge-refined (the local term integrated from shadow rays where the irradiance within α is not uniform; `core/src/refine.rs`): mean relative error in the shadow-edge band and overall, and its shading phase against edge-aware's (medians of the seeds).\n"
@@ -569,7 +569,7 @@ pub fn write_csv(report: &BenchReport, path: &Path) -> Result<(), BenchError> {
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{:e},{:e},{},{},{},{}",
             r.scene.name(),
-            crate::render::core_method(r.setting.method).name(),
+            r.setting.method.name(),
             r.setting.epsilon,
             r.smoothing,
             r.samples,

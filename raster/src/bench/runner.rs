@@ -10,7 +10,7 @@
 use std::time::Duration;
 
 use glam::Vec3;
-use lucent_core::QueryStats;
+use lucent_core::stats::QueryStats;
 
 use super::BenchError;
 use super::scenes::BenchScene;
@@ -18,14 +18,15 @@ use crate::output::{
     ErrorStats, NoiseStats, RgbImage, compare, default_band_radius, seed_noise, shadow_edge_band,
     translucent_mask,
 };
-use crate::render::{ObjectSamples, Render, RenderOptions, Timings, core_method, render};
-use crate::scene::{SampleDensity, Scene, SssMethod};
+use crate::render::{ObjectSamples, Render, RenderOptions, Timings, render};
+use crate::scene::{SampleDensity, Scene};
+use lucent_core::Method;
 
 /// One method with its settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MethodSetting {
     /// The method.
-    pub method: SssMethod,
+    pub method: Method,
     /// JB02 ε of the global (or whole) sum.
     pub epsilon: f32,
 }
@@ -35,9 +36,9 @@ impl MethodSetting {
     /// font has no ε).
     pub fn label(&self) -> String {
         match self.method {
-            SssMethod::Hierarchical => format!("hierarchical eps={}", self.epsilon),
-            SssMethod::Exhaustive => "exhaustive".to_string(),
-            m => core_method(m).name().to_string(),
+            Method::Hierarchical => format!("hierarchical eps={}", self.epsilon),
+            Method::Exhaustive => "exhaustive".to_string(),
+            m => m.name().to_string(),
         }
     }
 }
@@ -293,7 +294,7 @@ mod tests {
     fn a_render_against_itself_has_zero_error_and_the_reference_finds_its_edge() {
         let base = BenchScene::Sphere.load(48).unwrap();
         let setting = MethodSetting {
-            method: SssMethod::EdgeAware,
+            method: Method::EdgeAware,
             epsilon: 0.5,
         };
         let truth = render_once(&configure(&base, setting, 1500, 1), true, None).unwrap();

@@ -5,13 +5,13 @@ use std::path::Path;
 
 use lucent_core::{Profile, presets};
 
-use super::{BakeArgs, BenchArgs, MethodArg, RenderArgs, SamplesArg};
+use super::{BakeArgs, BenchArgs, RenderArgs, SamplesArg};
 use crate::bench::{self, BenchConfig, BenchScene};
 use crate::output::{write_exr, write_png};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
-    MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene, SssMethod,
-    default_scene, load_scene,
+    MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene, default_scene,
+    load_scene,
 };
 
 /// Loads the scene named on the command line, or the built-in default.
@@ -97,13 +97,7 @@ fn threads(n: Option<usize>, scene: &mut Scene) -> Result<(), String> {
 /// Applies the command-line overrides to the scene, validating each.
 fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
     if let Some(m) = args.method {
-        scene.render.method = match m {
-            MethodArg::Hierarchical => SssMethod::Hierarchical,
-            MethodArg::LocalGlobal => SssMethod::LocalGlobal,
-            MethodArg::EdgeAware => SssMethod::EdgeAware,
-            MethodArg::EdgeRefined => SssMethod::EdgeRefined,
-            MethodArg::Exhaustive => SssMethod::Exhaustive,
-        };
+        scene.render.method = m;
     }
     density(args.samples, args.spacing, args.max_samples, scene)?;
     threads(args.threads, scene)?;
@@ -252,7 +246,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             s.density
                 .as_ref()
                 .map_or(String::new(), |d| format!(" ({})", d.describe())),
-            render::core_method(scene.render.method).name(),
+            scene.render.method.name(),
             seconds(t.sampling),
             seconds(t.irradiance),
             seconds(t.cache),

@@ -8,7 +8,9 @@ mod compare;
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use clap::{Args, Parser, Subcommand};
+use lucent_core::Method;
 
 /// Render translucent materials: point-based subsurface scattering (Jensen & Buhler 2002,
 /// Langlands & Mertens 2007, Neulander 2010).
@@ -51,22 +53,6 @@ pub enum Command {
     Compare(CompareArgs),
 }
 
-/// Which subsurface method to shade with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum MethodArg {
-    /// Jensen & Buhler 2002: hierarchical octree sum, no smoothing.
-    Hierarchical,
-    /// Langlands & Mertens 2007: precomputed local term + global octree sum.
-    LocalGlobal,
-    /// Neulander 2010: local term from a kernel-weighted cache query (soft shadow edges).
-    EdgeAware,
-    /// Edge-aware, with the local term integrated from shadow rays where the irradiance
-    /// within the smoothing radius is not uniform (sharper, faithful shadow edges).
-    EdgeRefined,
-    /// Every sample, no approximation (slow; the reference).
-    Exhaustive,
-}
-
 /// Options of `render`.
 #[derive(Debug, Args, Clone, Default)]
 pub struct RenderArgs {
@@ -78,9 +64,9 @@ pub struct RenderArgs {
     /// Write the OpenEXR here (linear float; overrides the scene's `[output]` exr).
     #[arg(long, value_name = "OUT.exr")]
     pub exr: Option<PathBuf>,
-    /// Subsurface method.
-    #[arg(long, value_enum)]
-    pub method: Option<MethodArg>,
+    /// Subsurface method (docs/scene-format.md describes each).
+    #[arg(long, value_parser = method_parser())]
+    pub method: Option<Method>,
     /// Irradiance samples over all translucent surfaces: `auto` (the default, unless the scene
     /// gives a count) spaces them a quarter of the smallest diffuse mean free path ℓ_d of the
     /// translucent materials apart, up to --max-samples; or a count N.
@@ -132,6 +118,12 @@ pub enum SamplesArg {
     Auto,
     /// This many.
     Count(u64),
+}
+
+/// `--method`: one of the core's [`Method::ALL`] names, listed by `--help` and by the error
+/// for any other value.
+fn method_parser() -> impl TypedValueParser<Value = Method> {
+    PossibleValuesParser::new(Method::ALL.map(Method::name)).try_map(|name| name.parse::<Method>())
 }
 
 fn parse_samples(text: &str) -> Result<SamplesArg, String> {

@@ -13,7 +13,7 @@
 //! own sub-samples, so the image is the same for any thread count.
 
 use glam::Vec3;
-use lucent_core::NoStats;
+use lucent_core::stats::NoStats;
 use rayon::prelude::*;
 
 use super::RenderError;

@@ -32,7 +32,8 @@ use super::RenderError;
 use super::prepare::Prepared;
 use crate::material::Shader;
 use crate::sampling::{SampleTarget, hex_spacing, triangle_area};
-use crate::scene::{MAX_SAMPLES, RenderSettings, SampleDensity, SampleRequest, SssMethod};
+use crate::scene::{MAX_SAMPLES, RenderSettings, SampleDensity, SampleRequest};
+use lucent_core::Method;
 
 /// c: the automatic spacing as a fraction of the smallest diffuse mean free path ℓ_d.
 pub const AUTO_SPACING: f32 = 0.25;
@@ -159,7 +160,7 @@ impl DensityPlan {
 
     /// The under-resolution warning for `method`, if the spacing is above [`WARN_SPACING`] ·
     /// ℓ_d,min; `smoothing` is the split methods' factor k (α = k·√(A/N)).
-    pub fn warning(&self, method: SssMethod, smoothing: f32) -> Option<String> {
+    pub fn warning(&self, method: Method, smoothing: f32) -> Option<String> {
         let ratio = self.ratio();
         if !(ratio > WARN_SPACING) {
             return None;
@@ -173,9 +174,10 @@ impl DensityPlan {
             DensityOrigin::Spacing(s) => format!("spacing = {}", Sig(s)),
             DensityOrigin::Baked => format!("a baked set of {} samples", self.count),
         };
-        let name = crate::render::core_method(method).name();
+        let name = method.name();
+        // The unsplit methods sum the samples alone; the split ones smooth over α.
         let effect = match method {
-            SssMethod::Hierarchical | SssMethod::Exhaustive if ratio >= BLACK_SPACING => {
+            m if !m.is_split() && ratio >= BLACK_SPACING => {
                 let spacing = self.spacing();
                 let lost: Vec<&str> = (0..3)
                     .filter(|&c| spacing >= BLACK_SPACING * f.channels[c])
@@ -193,10 +195,10 @@ impl DensityPlan {
                     )
                 }
             }
-            SssMethod::Hierarchical | SssMethod::Exhaustive => format!(
+            m if !m.is_split() => format!(
                 "{name} will show blotches (bright spots at the samples, dark between them)"
             ),
-            SssMethod::LocalGlobal | SssMethod::EdgeAware | SssMethod::EdgeRefined => {
+            _ => {
                 let alpha = smoothing * (self.area / f64::from(self.count.max(1))).sqrt() as f32;
                 format!(
                     "{name} will render hard, stair-stepped shadow edges (its smoothing radius \
@@ -488,7 +490,7 @@ mod tests {
         assert_eq!(p.count, 25_879);
         assert!(p.count >= 23_000);
         assert_eq!(p.describe(), "auto: spacing 0.0988 = 0.25 ℓ_d");
-        assert_eq!(p.warning(SssMethod::Hierarchical, 1.5), None);
+        assert_eq!(p.warning(Method::Hierarchical, 1.5), None);
         // The shipped scene asks for the automatic count.
         let shipped = plan_of(&default_scene());
         assert_eq!(shipped.count, 25_879);
@@ -588,7 +590,7 @@ mod tests {
     fn the_warning_names_the_object_the_spacing_and_the_cure_per_method() {
         // The scanned head: 227 units², skin1 at 25 mm per unit, 23000 samples.
         let p = plan_with(DensityOrigin::Count, 23_000, 0.0273);
-        let split = p.warning(SssMethod::EdgeAware, 1.5).unwrap();
+        let split = p.warning(Method::EdgeAware, 1.5).unwrap();
         assert_eq!(
             split,
             "object 'head': irradiance samples 0.107 apart (samples = 23000) are 3.91× its \
@@ -597,9 +599,9 @@ mod tests {
              0.149 is 5.46× ℓ_d); about 5627169 samples (spacing 0.00683 = ℓ_d/4) would resolve \
              it (samples = \"auto\" / --samples auto gives that)"
         );
-        let lg = p.warning(SssMethod::LocalGlobal, 1.5).unwrap();
+        let lg = p.warning(Method::LocalGlobal, 1.5).unwrap();
         assert!(lg.contains("local-global will render hard, stair-stepped shadow edges"));
-        let h = p.warning(SssMethod::Hierarchical, 1.5).unwrap();
+        let h = p.warning(Method::Hierarchical, 1.5).unwrap();
         assert!(
             h.contains("hierarchical will show blotches (bright spots at the samples"),
             "{h}"
@@ -608,7 +610,7 @@ mod tests {
         let sparse = plan_with(DensityOrigin::Count, 23_000, 0.0005);
         assert!(sparse.ratio() > 2.0 * BLACK_SPACING);
         assert!(sparse.spacing() < 5.4 * 0.0005 * BLACK_SPACING);
-        for m in [SssMethod::Hierarchical, SssMethod::Exhaustive] {
+        for m in [Method::Hierarchical, Method::Exhaustive] {
             let w = sparse.warning(m, 1.5).unwrap();
             let lost = "will lose most of the object's green and blue light (the profile";
             assert!(w.contains(lost), "{w}");
@@ -619,14 +621,14 @@ mod tests {
         }
         // Beyond in every channel: black.
         let black = plan_with(DensityOrigin::Count, 23_000, 0.0001);
-        let w = black.warning(SssMethod::Exhaustive, 1.5).unwrap();
+        let w = black.warning(Method::Exhaustive, 1.5).unwrap();
         assert!(
             w.contains("exhaustive will render the object mostly black"),
             "{w}"
         );
         // Just below the black threshold: blotches.
         let blotchy = plan_with(DensityOrigin::Count, 23_000, 0.107 / 99.0);
-        let w = blotchy.warning(SssMethod::Hierarchical, 1.5).unwrap();
+        let w = blotchy.warning(Method::Hierarchical, 1.5).unwrap();
         assert!(w.contains("hierarchical will show blotches"), "{w}");
         // Capped auto points at the cap.
         let capped = plan_with(
@@ -637,7 +639,7 @@ mod tests {
             100_000,
             0.0273,
         );
-        let w = capped.warning(SssMethod::EdgeAware, 1.5).unwrap();
+        let w = capped.warning(Method::EdgeAware, 1.5).unwrap();
         assert!(
             w.contains("(samples = \"auto\" capped by max_samples = 100000)"),
             "{w}"
@@ -650,26 +652,21 @@ mod tests {
         // Spacings and baked sets.
         let s = plan_with(DensityOrigin::Spacing(0.05), 104_830, 0.0273);
         assert!(
-            s.warning(SssMethod::EdgeAware, 1.5)
+            s.warning(Method::EdgeAware, 1.5)
                 .unwrap()
                 .contains("(spacing = 0.0500)")
         );
         let b = plan_with(DensityOrigin::Baked, 23_000, 0.0273);
-        let w = b.warning(SssMethod::EdgeAware, 1.5).unwrap();
+        let w = b.warning(Method::EdgeAware, 1.5).unwrap();
         assert!(w.contains("(a baked set of 23000 samples)"), "{w}");
         // Beyond the hard limit: the units are suspect.
         let tiny = plan_with(DensityOrigin::Count, 23_000, 1e-4);
-        let w = tiny.warning(SssMethod::Exhaustive, 1.5).unwrap();
+        let w = tiny.warning(Method::Exhaustive, 1.5).unwrap();
         assert!(w.contains("more than the limit of 33554432"), "{w}");
         // At or below ℓ_d: no warning, for any method.
         let fine = plan_with(DensityOrigin::Count, 23_000, 0.107);
         assert!(fine.ratio() <= WARN_SPACING);
-        for m in [
-            SssMethod::Hierarchical,
-            SssMethod::LocalGlobal,
-            SssMethod::EdgeAware,
-            SssMethod::Exhaustive,
-        ] {
+        for m in Method::ALL {
             assert_eq!(fine.warning(m, 1.5), None);
         }
     }

@@ -1,5 +1,5 @@
 //! The edge-refined local term at one shading point: the irradiance at the core's quadrature
-//! nodes on the tangent disc ([`lucent_core::refine`]), from the same lights, occluders and
+//! nodes on the tangent disc ([`lucent_core::LocalQuadrature`]), from the same lights, occluders and
 //! shadow rays that light the irradiance samples.
 //!
 //! Called only where the edge-refined query flagged the point (the samples' irradiance within
@@ -14,15 +14,19 @@
 //! ```
 
 use glam::Vec3;
-use lucent_core::refine::{DEFAULT_PER_RING, DEFAULT_RINGS};
-use lucent_core::{Exitance, LocalQuadrature, Profile};
+use lucent_core::{Exitance, LocalQuadrature, LocalTerm, Profile};
 
 use crate::lights::{Lighting, ShadowHints};
 use crate::sampling::rng::splitmix64;
 
 /// The quadrature of the edge-refined method for `profile` and α (the default node count).
 pub fn quadrature(profile: &Profile, alpha: f32) -> LocalQuadrature {
-    LocalQuadrature::new(profile, alpha, DEFAULT_RINGS, DEFAULT_PER_RING)
+    LocalQuadrature::new(
+        profile,
+        alpha,
+        LocalQuadrature::DEFAULT_RINGS,
+        LocalQuadrature::DEFAULT_PER_RING,
+    )
 }
 
 /// What the refinement needs to know about the shading point.
@@ -34,8 +38,8 @@ pub struct RefinePoint {
     pub normal: Vec3,
     /// E(x).
     pub irradiance: Vec3,
-    /// K at x.
-    pub k: Vec3,
+    /// The local term (α and K) the query at x was given.
+    pub local: LocalTerm,
     /// The shading point's seed (rotation of the pattern, area-light strata of the nodes).
     pub seed: u64,
 }
@@ -50,15 +54,15 @@ pub fn refine(
 ) -> Exitance {
     let (t1, t2) = point.normal.any_orthonormal_pair();
     let rotation = LocalQuadrature::rotation(splitmix64(point.seed ^ 0x005E_ED0F_ED6E));
-    let mut at = [Vec3::ZERO; lucent_core::refine::MAX_NODES];
+    let mut at = [Vec3::ZERO; lucent_core::LocalQuadrature::MAX_NODES];
     for (n, e) in at.iter_mut().enumerate().take(quadrature.len()) {
         let o = quadrature.offset(n, rotation);
         let p = point.position + t1 * o.x + t2 * o.y + point.normal * quadrature.lift(n);
         let seed = splitmix64(point.seed.wrapping_add((n as u64 + 1) << 48));
         *e = lighting.irradiance_with(p, point.normal, seed, shadows);
     }
-    let local = quadrature.local_term(point.irradiance, point.k, &at[..quadrature.len()]);
-    m.with_local(local, point.k)
+    let local = quadrature.local_term(point.irradiance, point.local, &at[..quadrature.len()]);
+    m.with_local(local, point.local)
 }
 
 #[cfg(test)]
@@ -81,7 +85,8 @@ mod tests {
         }];
         let lighting = Lighting::new(&lights, None, 10.0);
         let q = quadrature(&marble(), 0.08);
-        let k = Vec3::new(0.3, 0.25, 0.2);
+        let local = LocalTerm::exact(&marble(), 0.08).unwrap();
+        let k = local.k();
         for seed in [0u64, 1, 77, u64::MAX] {
             let position = Vec3::new(0.3, -1.2, 0.0);
             let e = lighting.irradiance(position, Vec3::Z, seed);
@@ -89,7 +94,7 @@ mod tests {
                 position,
                 normal: Vec3::Z,
                 irradiance: e,
-                k,
+                local,
                 seed,
             };
             let m = Exitance {

@@ -31,7 +31,8 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lucent_core::{IrradianceCache, Method, NoStats, QuerySettings, QueryStats};
+use lucent_core::stats::{NoStats, QueryStats};
+use lucent_core::{IrradianceCache, QuerySettings};
 use rayon::prelude::*;
 
 pub use adaptive::{GroupScratch, ShadeGroup};
@@ -48,7 +49,7 @@ use crate::output::image::{LAYER_EXITANCE, LAYER_GLOBAL, LAYER_IRRADIANCE, LAYER
 use crate::output::{Layer, RgbImage};
 use crate::raster::{RasterError, VisibilityBuffer};
 use crate::sampling::SamplingError;
-use crate::scene::{Scene, SssMethod};
+use crate::scene::Scene;
 
 /// Why a render failed.
 #[derive(Debug)]
@@ -202,17 +203,6 @@ impl Render {
     }
 }
 
-/// The core's method for a scene's.
-pub fn core_method(method: SssMethod) -> Method {
-    match method {
-        SssMethod::Hierarchical => Method::Hierarchical,
-        SssMethod::LocalGlobal => Method::LocalGlobal,
-        SssMethod::EdgeAware => Method::EdgeAware,
-        SssMethod::EdgeRefined => Method::EdgeRefined,
-        SssMethod::Exhaustive => Method::Exhaustive,
-    }
-}
-
 fn bar(enabled: bool, len: u64, message: &'static str) -> ProgressBar {
     if !enabled {
         return ProgressBar::hidden();
@@ -333,7 +323,7 @@ fn render_in_pool(
 
     // Caches, and K tables for the split methods.
     let t = Instant::now();
-    let method = core_method(settings.method);
+    let method = settings.method;
     let built = match sets {
         Cow::Borrowed(baked) => baked
             .iter()
@@ -408,7 +398,6 @@ fn render_in_pool(
             method,
             epsilon: settings.epsilon,
             cull_tolerance: settings.cull_tolerance,
-            smoothing_radius: 0.0,
         },
         exact_local_integral: options.exact_local_integral,
         irradiance_everywhere: options.irradiance_layer || scene.output.layers.irradiance,

@@ -11,12 +11,9 @@
 use std::time::{Duration, Instant};
 
 use glam::{Mat4, Vec2, Vec3};
-use lucent_core::lanes::DefaultLanes;
-use lucent_core::table::exact_local_integral;
-use lucent_core::{
-    IrradianceCache, LocalQuadrature, NoStats, QuerySettings, QueryStats, ShadingPoint, StatsSink,
-    fresnel,
-};
+use lucent_core::internals::fresnel;
+use lucent_core::stats::{NoStats, QueryStats, StatsSink};
+use lucent_core::{IrradianceCache, LocalQuadrature, LocalTerm, QuerySettings, ShadingPoint};
 
 use super::RenderError;
 use super::adaptive::GroupScratch;
@@ -25,7 +22,7 @@ use super::edge_refined::{self, RefinePoint};
 use super::prepare::Prepared;
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
-use crate::material::{LocalTerm, Shader, TranslucentShader};
+use crate::material::{LocalIntegral, Shader, TranslucentShader};
 use crate::raster::{Fragment, VisibilityBuffer};
 use crate::sampling::rng::splitmix64;
 
@@ -37,11 +34,11 @@ pub struct ObjectCache {
     /// Smoothing radius α = k √Ā.
     pub alpha: f32,
     /// Where K comes from (split methods only).
-    pub local: Option<LocalTerm>,
+    pub local: Option<LocalIntegral>,
     /// K when the material does not vary over the surface: computed once here by quadrature
-    /// ([`LocalTerm::exact`]), so it carries no table interpolation error and costs no
+    /// ([`LocalIntegral::exact`]), so it carries no table interpolation error and costs no
     /// lookup at the shading points (a table lookup cost about 6% of a lookup on the sphere).
-    pub uniform_k: Option<Vec3>,
+    pub uniform_k: Option<LocalTerm>,
     /// The edge-refined quadrature when the material does not vary (textured materials build
     /// theirs at each refined point).
     pub quadrature: Option<LocalQuadrature>,
@@ -53,7 +50,7 @@ impl ObjectCache {
     pub fn new(
         cache: IrradianceCache,
         alpha: f32,
-        local: Option<LocalTerm>,
+        local: Option<LocalIntegral>,
         shader: Option<&TranslucentShader>,
     ) -> Result<ObjectCache, RenderError> {
         let (uniform_k, quadrature) = match (&local, shader) {
@@ -308,28 +305,26 @@ impl Shading<'_> {
                         }
                     });
                 }
-                let k = match (&oc.local, oc.uniform_k) {
+                let local = match (&oc.local, oc.uniform_k) {
                     (Some(_), _) if self.exact_local_integral => {
-                        exact_local_integral(&point.profile, oc.alpha)
+                        LocalTerm::exact(&point.profile, oc.alpha).map_err(|e| {
+                            RenderError::Material(format!("material '{}': {e}", shader.name))
+                        })?
                     }
-                    (Some(_), Some(k)) => k,
-                    (Some(term), None) => term.lookup(&point),
-                    (None, _) => Vec3::ZERO,
-                };
-                let settings = QuerySettings {
-                    smoothing_radius: oc.alpha,
-                    ..self.settings
+                    (Some(_), Some(term)) => term,
+                    (Some(source), None) => source.lookup(&point),
+                    (None, _) => LocalTerm::NONE,
                 };
                 let m = oc
                     .cache
-                    .query_with::<DefaultLanes, S>(
+                    .query_with_stats(
                         &point.profile,
                         &ShadingPoint {
                             position,
                             irradiance: e,
                         },
-                        k,
-                        &settings,
+                        local,
+                        &self.settings,
                         stats,
                     )
                     .map_err(|err| RenderError::Core(format!("query at {position}: {err}")))?;
@@ -341,7 +336,7 @@ impl Shading<'_> {
                         position,
                         normal,
                         irradiance: e,
-                        k,
+                        local,
                         seed,
                     };
                     edge_refined::refine(&lighting, &q, &at, shadows, m)
@@ -386,14 +381,15 @@ struct Surface {
 mod tests {
     use std::borrow::Cow;
 
-    use lucent_core::{Distance, Profile, fresnel};
+    use lucent_core::internals::fresnel;
+    use lucent_core::{Distance, Profile};
 
     use super::*;
     use crate::render::irradiance::build_caches;
     use crate::render::{RenderOptions, bake, render};
     use crate::scene::{Material, Medium, SceneOrigin, TranslucentMaterial, parse_scene};
-    use lucent_core::dipole::UnitDipole;
-    use lucent_core::table::local_integral_unit;
+    use lucent_core::internals::UnitDipole;
+    use lucent_core::internals::local_integral_unit;
 
     /// K by a quadrature of its own for each channel of `profile` (the definition, not the
     /// table's code path).
@@ -426,7 +422,7 @@ mod tests {
         let ell = profile.mean_free_path();
         for alpha in [0.01_f32, 0.03, 0.05, 0.2] {
             let local = shader.local_term(alpha, alpha / 1024.0).unwrap();
-            let LocalTerm::Single(table) = &local else {
+            let LocalIntegral::Single(table) = &local else {
                 panic!("a preset has one table")
             };
             let interpolated = table.lookup(ell);
@@ -438,6 +434,8 @@ mod tests {
             )
             .unwrap();
             let got = oc.uniform_k.expect("uniform material");
+            assert_eq!(got.alpha(), alpha);
+            let got = got.k();
             let want = quadrature_k(&profile, alpha);
             let error = ((got - want) / want).abs().max_element();
             assert!(error <= f32::EPSILON, "α {alpha}: K {got} vs {want}");

@@ -29,7 +29,7 @@
 //! consecutive candidates walks the triangles forward instead of searching them.
 
 use glam::{DVec3, Vec2, Vec3};
-use lucent_core::morton::Grid;
+use lucent_core::internals::Grid;
 
 use super::rng::Pcg32;
 use super::surface::{SurfacePoint, triangle_area};

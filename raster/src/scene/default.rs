@@ -45,8 +45,9 @@ pub fn default_scene() -> Scene {
 mod tests {
     use glam::{Vec3, Vec4Swizzles};
 
-    use super::super::model::{Light, Material, Medium, Mesh, SssMethod};
+    use super::super::model::{Light, Material, Medium, Mesh};
     use super::*;
+    use lucent_core::Method;
 
     fn object<'s>(scene: &'s Scene, name: &str) -> &'s Mesh {
         &scene
@@ -81,7 +82,7 @@ mod tests {
     fn default_scene_loads_with_its_settings() {
         let s = default_scene();
         assert_eq!((s.camera.width, s.camera.height), (512, 512));
-        assert_eq!(s.render.method, SssMethod::EdgeAware);
+        assert_eq!(s.render.method, Method::EdgeAware);
         assert_eq!(
             s.output.png.as_deref(),
             Some(std::path::Path::new("lucent.png"))

@@ -310,7 +310,7 @@ fn build_medium(
     ))
 }
 
-/// The relative index of refraction: required, in [1, `lucent_core::dipole::MAX_ETA`] (the
+/// The relative index of refraction: required, in [1, `lucent_core::Profile::MAX_ETA`] (the
 /// J01 Fresnel fit behind the dipole's boundary term is only sound there).
 fn eta(
     c: &Check,
@@ -320,7 +320,7 @@ fn eta(
     what: &str,
 ) -> Checked<f32> {
     let v = c.require(key, v, table, what)?;
-    let max = lucent_core::dipole::MAX_ETA;
+    let max = lucent_core::Profile::MAX_ETA;
     c.num_where(
         key,
         v,

@@ -40,4 +40,4 @@ pub use materials::preset_names;
 pub use model::*;
 pub use objects::SHAPES;
 pub use origin::{MAX_FILE_BYTES, SceneOrigin};
-pub use settings::{AUTO, DEFAULT_RESOLUTION, LAYERS, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, METHODS};
+pub use settings::{AUTO, DEFAULT_RESOLUTION, LAYERS, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE};

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
+use lucent_core::Method;
 
 use crate::camera::Camera;
 use crate::texture::Texture;
@@ -212,25 +213,6 @@ pub enum Light {
     },
 }
 
-/// Which subsurface method shades translucent pixels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum SssMethod {
-    /// Jensen & Buhler 2002: hierarchical octree sum, no smoothing.
-    Hierarchical,
-    /// Langlands & Mertens 2007: local term E(x)·K plus the octree's (1 − w) global sum.
-    LocalGlobal,
-    /// Neulander 2010: like local-global, with the local irradiance a kernel-weighted cache
-    /// query (soft, faithful shadow edges). The default.
-    #[default]
-    EdgeAware,
-    /// Edge-aware, with the local term a quadrature of the irradiance over the smoothing disc
-    /// (shadow rays at fixed nodes) wherever the irradiance within it is not uniform (a
-    /// departure from Neulander 2010; `lucent_core::refine`).
-    EdgeRefined,
-    /// Every sample, no approximation (the reference).
-    Exhaustive,
-}
-
 /// A concrete irradiance sample density: what the sample placement is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SampleDensity {
@@ -262,7 +244,7 @@ impl From<SampleDensity> for SampleRequest {
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     /// Subsurface method.
-    pub method: SssMethod,
+    pub method: Method,
     /// Irradiance sample density: automatic, or a count or spacing.
     pub samples: SampleRequest,
     /// The most samples `Auto` may place; `None` = sized to the machine's available memory
@@ -290,7 +272,7 @@ pub struct RenderSettings {
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
-            method: SssMethod::EdgeAware,
+            method: Method::EdgeAware,
             samples: SampleRequest::Auto,
             max_samples: None,
             epsilon: 0.5,

@@ -3,14 +3,13 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
+use lucent_core::error::ParseMethodError;
 use toml::Spanned;
 
 use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::{RawCamera, RawOutput, RawRender, RawSamples};
-use super::model::{
-    ExrLayers, OutputSettings, RenderSettings, SampleDensity, SampleRequest, SssMethod,
-};
+use super::model::{ExrLayers, OutputSettings, RenderSettings, SampleDensity, SampleRequest};
 use crate::camera::Camera;
 
 /// Default image width and height.
@@ -27,15 +26,6 @@ pub const MAX_SAMPLES: i64 = 1 << 25;
 
 /// The word that asks for an automatic sample count (`samples = "auto"`, `--samples auto`).
 pub const AUTO: &str = "auto";
-
-/// Values accepted by `render.method`.
-pub const METHODS: [(&str, SssMethod); 5] = [
-    ("hierarchical", SssMethod::Hierarchical),
-    ("local-global", SssMethod::LocalGlobal),
-    ("edge-aware", SssMethod::EdgeAware),
-    ("edge-refined", SssMethod::EdgeRefined),
-    ("exhaustive", SssMethod::Exhaustive),
-];
 
 /// Values accepted in `output.layers`.
 pub const LAYERS: [&str; 5] = ["exitance", "local", "global", "irradiance", "depth"];
@@ -128,22 +118,14 @@ pub(crate) fn build_render(
     };
     let r = raw.get_ref();
     if let Some(m) = &r.method {
-        s.method = METHODS
-            .iter()
-            .find(|(name, _)| *name == m.get_ref().as_str())
-            .map(|(_, method)| *method)
-            .ok_or_else(|| {
-                c.at(
-                    SceneErrorKind::UnknownName,
-                    "render.method",
-                    m,
-                    format!(
-                        "unknown method `{}` (expected one of: {})",
-                        m.get_ref(),
-                        METHODS.map(|(n, _)| n).join(", ")
-                    ),
-                )
-            })?;
+        s.method = m.get_ref().parse().map_err(|e: ParseMethodError| {
+            c.at(
+                SceneErrorKind::UnknownName,
+                "render.method",
+                m,
+                e.to_string(),
+            )
+        })?;
     }
     match (&r.samples, &r.spacing) {
         (Some(_), Some(spacing)) => {

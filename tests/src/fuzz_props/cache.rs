@@ -51,10 +51,11 @@
 //! bound for recursive summation); the lanes' exponential adds 4e-7. The absolute allowance
 //! covers terms that underflow.
 
-use lucent_core::cache::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
+use lucent_core::error::QueryError;
 use lucent_core::glam::{DVec3, Vec3};
+use lucent_core::internals::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
 use lucent_core::{
-    Distance, Exitance, IrradianceCache, LocalIntegralTable, Method, Profile, QueryError,
+    Distance, Exitance, IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile,
     QuerySettings, Sample, ShadingPoint,
 };
 
@@ -260,13 +261,14 @@ pub fn cache_query_matches_exhaustive(data: &[u8]) {
             )
         });
     let alpha = cache.smoothing_radius(case.smoothing);
-    let (alpha, k) = if alpha > 0.0 && alpha.is_finite() {
+    let local = if alpha > 0.0 && alpha.is_finite() {
         let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0)
             .unwrap_or_else(|e| panic!("table for α {alpha}: {e}"));
-        (alpha, table.lookup(profile.mean_free_path()))
+        table.local_term(profile.mean_free_path())
     } else {
-        (0.0, Vec3::ZERO)
+        LocalTerm::NONE
     };
+    let (alpha, k) = (local.alpha(), local.k());
     assert!(
         k.is_finite() && k.min_element() >= 0.0,
         "K {k} for α {alpha}"
@@ -309,9 +311,8 @@ pub fn cache_query_matches_exhaustive(data: &[u8]) {
             method,
             epsilon,
             cull_tolerance,
-            smoothing_radius: alpha,
         };
-        let query = |s: QuerySettings| cache.query(&profile, &point, k, &s);
+        let query = |s: QuerySettings| cache.query(&profile, &point, local, &s);
         if !x.is_finite() {
             for method in Method::ALL {
                 let got = query(settings(method, 0.0, 0.0));

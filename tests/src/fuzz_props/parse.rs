@@ -94,10 +94,13 @@ pub fn scene_parse_never_panics(data: &[u8]) {
     let settings = QuerySettings {
         epsilon: r.epsilon,
         cull_tolerance: r.cull_tolerance,
-        smoothing_radius: r.smoothing,
         ..Default::default()
     };
     assert!(settings.validate().is_ok(), "render settings {r:?}");
+    assert!(
+        r.smoothing.is_finite() && r.smoothing >= 0.0,
+        "render settings {r:?}"
+    );
     assert!((1..=MAX_AA).contains(&r.aa), "render settings {r:?}");
 }
 

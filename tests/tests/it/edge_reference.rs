@@ -16,9 +16,9 @@
 //! never hides the plane; each pixel's plane point is its centre's ray (aa = 1), checked
 //! against the rendered depth.
 
-use lucent_core::dipole::UnitDipole;
 use lucent_core::glam::Vec3;
-use lucent_core::quadrature::GaussLegendre;
+use lucent_core::internals::GaussLegendre;
+use lucent_core::internals::UnitDipole;
 use lucent_core::{Profile, presets};
 use lucent_raster::camera::Camera;
 use lucent_raster::render::{ObjectSamples, RenderOptions, bake, render};

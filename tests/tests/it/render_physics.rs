@@ -6,10 +6,12 @@
 //!   the shadow's inside edge brighter than its interior;
 //! - the image is the same, bit for bit, on every run and for any thread count.
 
+use lucent_core::Method;
 use lucent_core::glam::Vec3;
-use lucent_core::{Distance, Profile, fresnel};
+use lucent_core::internals::fresnel;
+use lucent_core::{Distance, Profile};
 use lucent_raster::render::{RenderOptions, render};
-use lucent_raster::scene::{Scene, SceneOrigin, SssMethod, parse_scene};
+use lucent_raster::scene::{Scene, SceneOrigin, parse_scene};
 
 /// K_d of the test plane (ℓ_d ≤ 1.8 with ℓ_u = 0.5, so the 40 × 40 plane extends 11
 /// diffusion lengths around its centre: the missing tail is e^−11).
@@ -225,7 +227,7 @@ fn renders_are_identical_across_runs_and_thread_counts() {
         assert_eq!(one, bits(&scene), "{threads} threads differ from 1");
     }
     // And the method matters (the test is not trivially comparing zeros).
-    scene.render.method = SssMethod::Hierarchical;
+    scene.render.method = Method::Hierarchical;
     assert_ne!(one, bits(&scene));
 }
 

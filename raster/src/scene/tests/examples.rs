@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
+use lucent_core::Method;
 
 use super::*;
 
@@ -164,7 +165,7 @@ layers = ["local", "depth"]
     assert_eq!(
         s.render,
         RenderSettings {
-            method: SssMethod::LocalGlobal,
+            method: Method::LocalGlobal,
             samples: SampleDensity::Spacing(0.05).into(),
             max_samples: None,
             epsilon: 0.1,

@@ -1,0 +1,182 @@
+//! Local-integral tables for a texture-mapped diffuse reflectance K_d (N10's table generalised,
+//! `docs/physics.md` §14).
+//!
+//! A [`LocalIntegralTable`] serves every ℓ_u of one material because K depends on α/ℓ_u and the
+//! reduced albedo α′ only, and α′ is fixed by K_d. Where K_d varies over the surface, α′ does
+//! too, so one table per K_d is needed: [`LocalIntegralByKd`] holds tables at the
+//! [`LocalIntegralByKd::LEVELS`] + 1 evenly spaced K_d = i / LEVELS (clamped into
+//! [0.001, 0.999]) and interpolates linearly in K_d, per channel, between the two bracketing
+//! tables, each looked up at the point's ℓ_u:
+//!
+//! ```text
+//!   K(K_d, ℓ) = K_i(ℓ) + (K_i+1(ℓ) − K_i(ℓ))·t,   i = ⌊K_d·LEVELS⌋,  t = K_d·LEVELS − i
+//!
+//!   levels:   K_d = 0.001  1/64  2/64  …  63/64  0.999
+//!   tables:   [0]          [1]   [2]   …  [63]   [64]     (each lock-free, filled on use)
+//! ```
+//!
+//! K is smooth in K_d (measured against a table built for the exact K_d: within 0.2% at 64
+//! levels, test `between_levels_matches_a_table_for_that_reflectance`).
+
+use alloc::vec::Vec;
+
+use glam::Vec3;
+
+use crate::error::ParamError;
+use crate::local_term::LocalTerm;
+use crate::profile::{Distance, Profile};
+use crate::table::LocalIntegralTable;
+
+/// Local-integral tables at evenly spaced K_d for one η and smoothing radius α, for a material
+/// whose diffuse reflectance K_d is texture-mapped. `Send + Sync`; lookups are lock-free (each
+/// table is, and the set of tables is fixed at construction).
+#[derive(Debug)]
+pub struct LocalIntegralByKd {
+    /// `levels[i]`: the table for K_d = i / LEVELS, clamped into [0.001, 0.999].
+    levels: Vec<LocalIntegralTable>,
+    alpha: f32,
+    ell_min: f32,
+}
+
+impl LocalIntegralByKd {
+    /// Intervals between the K_d levels (the tables are one more).
+    pub const LEVELS: usize = 64;
+
+    /// The tables for relative index `eta`, smoothing radius `alpha` and threshold `ell_min`
+    /// (scene units; as [`LocalIntegralTable::new`]). Only the tables' headers are built here;
+    /// their values are computed by the lookups that need them.
+    pub fn new(eta: f32, alpha: f32, ell_min: f32) -> Result<Self, ParamError> {
+        let levels = (0..=Self::LEVELS)
+            .map(|i| {
+                let kd = (i as f32 / Self::LEVELS as f32).clamp(0.001, 0.999);
+                // ℓ_u is what each table varies; 1 is as good as any.
+                let profile = Profile::from_reflectance(
+                    Vec3::splat(kd),
+                    Distance::MeanFreePath(Vec3::ONE),
+                    eta,
+                )?;
+                LocalIntegralTable::new(&profile, alpha, ell_min)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(LocalIntegralByKd {
+            levels,
+            alpha,
+            ell_min,
+        })
+    }
+
+    /// The smoothing radius α.
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// The threshold ℓ_min.
+    pub fn ell_min(&self) -> f32 {
+        self.ell_min
+    }
+
+    /// The table of level i (K_d = i / [`LocalIntegralByKd::LEVELS`], clamped into
+    /// [0.001, 0.999]), `None` beyond the last.
+    pub fn level(&self, i: usize) -> Option<&LocalIntegralTable> {
+        self.levels.get(i)
+    }
+
+    /// K per channel at diffuse reflectance `kd` (each channel clamped into [0, 1]) and mean
+    /// free path `ell_u`: each channel's two bracketing levels looked up at that channel's ℓ
+    /// and interpolated linearly in K_d.
+    pub fn lookup(&self, kd: Vec3, ell_u: Vec3) -> Vec3 {
+        let mut k = Vec3::ZERO;
+        for c in 0..3 {
+            // NaN clamps to NaN and casts to 0: level 0.
+            let x = kd[c].clamp(0.0, 1.0) * Self::LEVELS as f32;
+            let i = (x as usize).min(Self::LEVELS - 1);
+            let t = x - i as f32;
+            let lo = self.levels[i].lookup_channel(c, ell_u[c]);
+            let hi = self.levels[i + 1].lookup_channel(c, ell_u[c]);
+            k[c] = lo + (hi - lo) * t;
+        }
+        k
+    }
+
+    /// [`LocalIntegralByKd::lookup`] bound to this α: the local term of a query
+    /// ([`crate::IrradianceCache::query`]).
+    #[inline]
+    pub fn local_term(&self, kd: Vec3, ell_u: Vec3) -> LocalTerm {
+        LocalTerm::new(self.alpha, self.lookup(kd, ell_u))
+    }
+}
+
+const _: () = {
+    const fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<LocalIntegralByKd>();
+};
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use super::*;
+
+    /// Between levels: within 0.2% of a table built for exactly that K_d and looked up at the
+    /// same ℓ (the ℓ interpolation is common to both, so this isolates the K_d interpolation).
+    #[test]
+    fn between_levels_matches_a_table_for_that_reflectance() {
+        let (eta, alpha) = (1.4, 0.07);
+        let tables = LocalIntegralByKd::new(eta, alpha, alpha / 1024.0).unwrap();
+        let mut worst = 0.0f32;
+        for kd in [
+            Vec3::new(0.3, 0.55, 0.9),
+            Vec3::new(0.05, 0.12, 0.71),
+            Vec3::new(0.97, 0.4, 0.26),
+        ] {
+            for ell in [0.005, 0.05, 0.5] {
+                let ell = Vec3::splat(ell);
+                let got = tables.lookup(kd, ell);
+                let profile =
+                    Profile::from_reflectance(kd, Distance::MeanFreePath(ell), eta).unwrap();
+                let own = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0)
+                    .unwrap()
+                    .lookup(ell);
+                worst = worst.max(((got - own) / own).abs().max_element());
+            }
+        }
+        assert!(worst < 0.002, "worst relative error {worst}");
+        // And not trivially: the levels differ from each other by far more than that.
+        let ell = Vec3::splat(0.05);
+        let (a, b) = (
+            tables.lookup(Vec3::splat(0.3), ell),
+            tables.lookup(Vec3::splat(0.6), ell),
+        );
+        assert!(((a - b) / b).abs().min_element() > 0.1, "{a} vs {b}");
+    }
+
+    /// At a level, K is that level's table exactly (t = 0), and the local term carries α.
+    #[test]
+    fn at_a_level_it_is_that_tables_lookup() {
+        let alpha = 0.2;
+        let tables = LocalIntegralByKd::new(1.3, alpha, alpha / 1024.0).unwrap();
+        let ell = Vec3::new(0.01, 0.1, 1.0);
+        let kd = Vec3::splat(16.0 / 64.0);
+        assert_eq!(
+            tables.lookup(kd, ell),
+            tables.level(16).unwrap().lookup(ell)
+        );
+        let term = tables.local_term(kd, ell);
+        assert_eq!((term.alpha(), term.k()), (alpha, tables.lookup(kd, ell)));
+        assert!(tables.level(LocalIntegralByKd::LEVELS + 1).is_none());
+        // K_d = 1 is level 64 (0.999), reached at t = 1 of the last interval.
+        let top = tables.lookup(Vec3::ONE, ell);
+        let last = tables.level(LocalIntegralByKd::LEVELS).unwrap().lookup(ell);
+        assert!(
+            ((top - last) / last).abs().max_element() < 1e-6,
+            "{top} vs {last}"
+        );
+    }
+
+    #[test]
+    fn invalid_inputs_are_errors() {
+        assert!(LocalIntegralByKd::new(0.5, 0.1, 0.0).is_err());
+        assert!(LocalIntegralByKd::new(1.3, 0.0, 0.0).is_err());
+        assert!(LocalIntegralByKd::new(1.3, 0.1, f32::NAN).is_err());
+    }
+}
