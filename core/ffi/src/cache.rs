@@ -3,7 +3,7 @@
 
 use crate::bridge::Cache;
 use crate::ptr;
-use crate::status::{LucentStatus, guard};
+use crate::status::{LucentStatus, guard, guard_void};
 use crate::types::LucentSample;
 
 /// An irradiance cache built from samples. Opaque; made by `lucent_cache_build`, freed by
@@ -59,8 +59,11 @@ pub unsafe extern "C" fn lucent_cache_build(
 /// afterwards, and no other thread is querying it.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn lucent_cache_free(cache: *mut LucentCache) {
-    // SAFETY: NULL or a live handle made by `ptr::into_handle`, never used again (contract).
-    unsafe { ptr::free(cache) }
+    guard_void(|| {
+        // SAFETY: NULL or a live handle made by `ptr::into_handle`, never used again
+        // (this function's contract).
+        unsafe { ptr::free(cache) }
+    })
 }
 
 /// Writes the number of samples in the cache to `*out`.

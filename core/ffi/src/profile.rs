@@ -5,7 +5,7 @@ use std::ffi::c_char;
 
 use crate::bridge::Material;
 use crate::ptr;
-use crate::status::{Failure, LucentStatus, guard};
+use crate::status::{Failure, LucentStatus, guard, guard_void};
 use crate::types::LucentCoefficients;
 
 /// A material's RGB diffusion profile (the dipole of Jensen et al. 2001 per channel).
@@ -91,8 +91,11 @@ pub unsafe extern "C" fn lucent_profile_from_coefficients(
 /// afterwards.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn lucent_profile_free(profile: *mut LucentProfile) {
-    // SAFETY: NULL or a live handle made by `ptr::into_handle`, never used again (contract).
-    unsafe { ptr::free(profile) }
+    guard_void(|| {
+        // SAFETY: NULL or a live handle made by `ptr::into_handle`, never used again
+        // (this function's contract).
+        unsafe { ptr::free(profile) }
+    })
 }
 
 /// Writes three floats to `out`: the profile's value per RGB channel.

@@ -72,12 +72,18 @@ thread_local! {
 
 /// Replaces this thread's message. Interior NUL bytes (impossible in the library's own
 /// messages, possible in an echoed argument) become U+FFFD so that the C string is whole.
+/// Runs outside `catch_unwind`, so it cannot panic: during thread teardown, when the slot is
+/// gone, the message is dropped.
 fn set_last_error(message: String) {
     let message = CString::new(message).unwrap_or_else(|e| {
         let cleaned = String::from_utf8_lossy(&e.into_vec()).replace('\0', "\u{fffd}");
         CString::new(cleaned).unwrap_or_default()
     });
-    LAST_ERROR.with(|slot| *slot.borrow_mut() = message);
+    let _ = LAST_ERROR.try_with(|slot| {
+        if let Ok(mut slot) = slot.try_borrow_mut() {
+            *slot = message;
+        }
+    });
 }
 
 /// The text of a panic payload (`panic!` gives a `&str` or a `String`).
@@ -108,12 +114,27 @@ pub(crate) fn guard(body: impl FnOnce() -> Result<(), Failure>) -> LucentStatus 
     status
 }
 
+/// [`guard`] for the `*_free` functions, which return nothing: a panic (of a destructor) is
+/// caught and recorded as the thread's message.
+pub(crate) fn guard_void(body: impl FnOnce()) {
+    guard(|| {
+        body();
+        Ok(())
+    });
+}
+
 /// The message of the last failed `lucent_*` call on the calling thread, or "" if that call
 /// succeeded. Never NULL. The string belongs to the library and stays valid until the next
 /// `lucent_*` call on the same thread (this function excepted); copy it to keep it.
 #[unsafe(no_mangle)]
 pub extern "C" fn lucent_last_error_message() -> *const c_char {
-    LAST_ERROR.with(|slot| slot.borrow().as_ptr())
+    // Cannot panic: no `with` (which panics during thread teardown), no `borrow` (which
+    // panics while the slot is being written; nothing here re-enters).
+    LAST_ERROR
+        .try_with(|slot| slot.try_borrow().map(|message| message.as_ptr()).ok())
+        .ok()
+        .flatten()
+        .unwrap_or(c"".as_ptr())
 }
 
 #[cfg(test)]
@@ -183,6 +204,21 @@ mod tests {
         .join()
         .unwrap();
         assert_eq!(last_message(), "main thread");
+    }
+
+    #[test]
+    fn a_panic_in_a_destructor_is_caught_and_reported() {
+        struct Exploding;
+        impl Drop for Exploding {
+            fn drop(&mut self) {
+                panic!("drop");
+            }
+        }
+        let doomed = Exploding;
+        guard_void(move || drop(doomed));
+        assert_eq!(last_message(), "internal error: drop");
+        guard_void(|| ());
+        assert_eq!(last_message(), "");
     }
 
     #[test]
