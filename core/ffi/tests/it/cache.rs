@@ -81,6 +81,38 @@ fn a_bad_sample_is_named_and_nothing_is_built() {
 }
 
 #[test]
+fn totals_beyond_single_precision_are_refused() {
+    let huge = LucentSample {
+        area: 3e38,
+        ..LucentSample::default()
+    };
+    assert_eq!(
+        build(&[huge, huge]).err(),
+        Some(LucentStatus::LUCENT_INVALID_ARGUMENT)
+    );
+    assert!(
+        message().starts_with("the samples' total area"),
+        "{}",
+        message()
+    );
+}
+
+#[test]
+fn a_count_beyond_the_address_space_is_refused_before_any_read() {
+    let one = LucentSample::default();
+    let mut out = ptr::null_mut();
+    // SAFETY: the count is checked before the array is read; `out` is writable.
+    let status = unsafe { lucent_cache_build(&one, usize::MAX / 8, &mut out) };
+    assert_eq!(status, LucentStatus::LUCENT_INVALID_ARGUMENT);
+    assert!(
+        message().contains("exceeds the address space"),
+        "{}",
+        message()
+    );
+    assert!(out.is_null());
+}
+
+#[test]
 fn the_handles_are_shareable_across_threads() {
     fn shareable<T: Send + Sync>() {}
     shareable::<LucentCache>();
