@@ -70,12 +70,16 @@ int main(void) {
     const char *names[2] = {"edge-aware", "hierarchical"};
     int failures = 0;
     for (int m = 0; m < 2; m++) {
-        /* Smoothing radius 2 * sqrt(mean sample area), and K for it (computed once). */
-        LucentQuerySettings settings;
-        check(lucent_query_settings_init(skin, cache, (uint32_t)methods[m], 2.0f, &settings),
-              "lucent_query_settings_init");
+        /* Smoothing radius 2 * sqrt(mean sample area) and K for it, computed once per plan. */
+        LucentQueryOptions options;
+        check(lucent_query_options_init(&options), "lucent_query_options_init");
+        options.method = (uint32_t)methods[m];
+        options.smoothing_factor = 2.0f;
+        LucentQuery *query = NULL;
+        check(lucent_query_new(skin, cache, &options, &query), "lucent_query_new");
         LucentExitance exitance;
-        check(lucent_query(skin, cache, &settings, &point, &exitance), "lucent_query");
+        check(lucent_query_point(query, cache, &point, &exitance), "lucent_query_point");
+        lucent_query_free(query);
         float radiance[3];
         check(lucent_profile_radiance(skin, exitance.total, cosf(0.5235988f), radiance),
               "lucent_profile_radiance");
@@ -104,9 +108,10 @@ int main(void) {
     } else {
         printf("unknown preset: %s\n", lucent_last_error_message());
     }
-    status = lucent_query(skin, cache, NULL, &point, NULL);
+    LucentExitance unused;
+    status = lucent_query_point(NULL, cache, &point, &unused);
     if (status != LUCENT_NULL_POINTER) {
-        fprintf(stderr, "embed: NULL settings gave status %d\n", (int)status);
+        fprintf(stderr, "embed: a NULL query gave status %d\n", (int)status);
         failures++;
     }
 

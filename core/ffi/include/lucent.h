@@ -45,7 +45,7 @@ typedef enum LucentStatus {
 } LucentStatus;
 
 /**
- * Which sum a query evaluates (`LucentQuerySettings.method`). The value 4 is the
+ * Which sum a query evaluates (`LucentQueryOptions.method`). The value 4 is the
  * edge-refined method, which needs irradiance evaluated by the caller at quadrature points the
  * query picks; the C interface does not offer it and answers `LUCENT_UNSUPPORTED`.
  */
@@ -82,6 +82,13 @@ typedef struct LucentCache LucentCache;
  * by `lucent_profile_free`. Immutable: one profile may be used from many threads at once.
  */
 typedef struct LucentProfile LucentProfile;
+
+/**
+ * A query plan: a copy of a profile, a method with its settings, the smoothing radius α and
+ * the local integral K computed for it. Opaque; made by `lucent_query_new`, freed by
+ * `lucent_query_free`. Immutable: one plan may be used from many threads at once.
+ */
+typedef struct LucentQuery LucentQuery;
 
 /**
  * One irradiance sample: a patch of surface, the area it stands for and the irradiance
@@ -127,34 +134,28 @@ typedef struct LucentCoefficients {
 } LucentCoefficients;
 
 /**
- * How to query. Fill it with `lucent_query_settings_init`, which computes the smoothing
- * radius and the local integral K that belong together; `epsilon` and `cull_tolerance` may
- * then be changed freely. After changing `smoothing_radius`, recompute `local_integral` with
- * `lucent_profile_local_integral` for the new radius.
+ * How to query: the input of `lucent_query_new`. `lucent_query_options_init` fills in the
+ * defaults (edge-aware, smoothing factor 2, ε = 0.05, cull tolerance 1e-4).
  */
-typedef struct LucentQuerySettings {
+typedef struct LucentQueryOptions {
   /**
    * A `LucentMethod` value.
    */
   uint32_t method;
   /**
+   * k in the smoothing radius α = k·√Ā of local-global and edge-aware (Ā the cache's mean
+   * sample area; N10 suggests 1 to 4), finite and ≥ 0. Ignored by the other methods.
+   */
+  float smoothing_factor;
+  /**
    * JB02's solid-angle threshold ε: a node is aggregated when A/|x − P|² < ε (0 = never).
-   * Default 0.05.
    */
   float epsilon;
   /**
-   * Relative tolerance for skipping negligible subtrees (0 = never). Default 1e-4.
+   * Relative tolerance for skipping negligible subtrees (0 = never).
    */
   float cull_tolerance;
-  /**
-   * Smoothing radius α (scene units) of local-global and edge-aware.
-   */
-  float smoothing_radius;
-  /**
-   * The local integral K per channel for this profile and `smoothing_radius`.
-   */
-  float local_integral[3];
-} LucentQuerySettings;
+} LucentQueryOptions;
 
 /**
  * The point being shaded.
@@ -297,8 +298,7 @@ enum LucentStatus lucent_profile_from_coefficients(const struct LucentCoefficien
                                                    struct LucentProfile **out);
 
 /**
- * Frees a profile. NULL is a no-op. Caches and settings made with it stay valid (they do not
- * refer to it).
+ * Frees a profile. NULL is a no-op. Query plans made with it stay valid (they copy it).
  *
  * # Safety
  *
@@ -328,9 +328,9 @@ enum LucentStatus lucent_profile_mean_free_path(const struct LucentProfile *prof
 
 /**
  * Writes the local integral K per RGB channel for smoothing radius `alpha` (scene units,
- * finite and > 0) to `out[0..3]`: what `LucentQuerySettings.local_integral` must hold for
- * `smoothing_radius = alpha` (`lucent_query_settings_init` computes it for you). Costs a few
- * numerical quadratures: compute it once per profile and radius, not per query.
+ * finite and > 0) to `out[0..3]`: the fraction of a uniform irradiance that the local term of
+ * local-global and edge-aware gathers within α (`lucent_query_new` computes it for its plan).
+ * Costs a few numerical quadratures.
  *
  * # Safety
  *
@@ -369,66 +369,103 @@ enum LucentStatus lucent_profile_radiance(const struct LucentProfile *profile,
 enum LucentStatus lucent_method_from_name(const char *name, enum LucentMethod *out);
 
 /**
- * Fills `*out` with settings for `method` (a `LucentMethod` value) on this profile and cache:
- * ε = 0.05, cull tolerance 1e-4, smoothing radius α = `smoothing_factor`·√Ā (Ā the cache's
- * mean sample area; see `lucent_cache_smoothing_radius`), and for local-global and
- * edge-aware the local integral K of the profile for α (a few quadratures: call this once per
- * profile, cache and method, not per query).
- *
- * Fails with `LUCENT_INVALID_ARGUMENT` for an unknown method, a negative or non-finite
- * `smoothing_factor`, or a zero α with local-global or edge-aware (factor 0, or an empty
- * cache); `LUCENT_UNSUPPORTED` for edge-refined (4); `LUCENT_NULL_POINTER` for a NULL
- * argument. `*out` is written only on success.
+ * Writes the default options to `*out`: edge-aware, smoothing factor 2, ε = 0.05, cull
+ * tolerance 1e-4.
  *
  * # Safety
  *
- * `profile` and `cache` are NULL or live handles; `out` is NULL or valid for writing a
- * `LucentQuerySettings`.
+ * `out` is NULL or valid for writing a `LucentQueryOptions`.
  */
-enum LucentStatus lucent_query_settings_init(const struct LucentProfile *profile,
-                                             const struct LucentCache *cache,
-                                             uint32_t method,
-                                             float smoothing_factor,
-                                             struct LucentQuerySettings *out);
+enum LucentStatus lucent_query_options_init(struct LucentQueryOptions *out);
+
+/**
+ * Makes a query plan for `profile` with `options`: the smoothing radius is α =
+ * `options->smoothing_factor`·√Ā with Ā the mean sample area of `cache` (see
+ * `lucent_cache_smoothing_radius`), and for local-global and edge-aware the local integral K
+ * of the profile for α is computed here (a few numerical quadratures: make one plan per
+ * material and cache, not one per query). The plan copies what it needs: `profile` may be
+ * freed afterwards, and the plan may query any cache (α stays what it was made with).
+ *
+ * On success `*out` is a new plan to free with `lucent_query_free`; on failure `*out` is set
+ * to NULL (when `out` is not NULL). Fails with `LUCENT_INVALID_ARGUMENT` for an unknown
+ * method, a negative or non-finite option, or a zero α with local-global or edge-aware
+ * (factor 0, or an empty cache); `LUCENT_UNSUPPORTED` for edge-refined (4);
+ * `LUCENT_NULL_POINTER` for a NULL argument.
+ *
+ * # Safety
+ *
+ * `profile` and `cache` are NULL or live handles; `options` is NULL or points to a
+ * `LucentQueryOptions`; `out` is NULL or valid for writing a pointer.
+ */
+enum LucentStatus lucent_query_new(const struct LucentProfile *profile,
+                                   const struct LucentCache *cache,
+                                   const struct LucentQueryOptions *options,
+                                   struct LucentQuery **out);
+
+/**
+ * Frees a query plan. NULL is a no-op.
+ *
+ * # Safety
+ *
+ * `query` is NULL or a plan from this library that has not been freed, is not used
+ * afterwards, and no other thread is using it.
+ */
+void lucent_query_free(struct LucentQuery *query);
+
+/**
+ * Writes the plan's smoothing radius α (scene units) to `*out`.
+ *
+ * # Safety
+ *
+ * `query` is NULL or a live plan; `out` is NULL or valid for writing a float.
+ */
+enum LucentStatus lucent_query_smoothing_radius(const struct LucentQuery *query, float *out);
+
+/**
+ * Writes the plan's local integral K per RGB channel to `out[0..3]` (zero for hierarchical
+ * and exhaustive): the fraction of a uniform irradiance that the local term gathers within α.
+ *
+ * # Safety
+ *
+ * `query` is NULL or a live plan; `out` is NULL or valid for writing 3 floats.
+ */
+enum LucentStatus lucent_query_local_integral(const struct LucentQuery *query, float *out);
 
 /**
  * Writes the radiant exitance at `point` to `*out`: light that entered the surface at the
- * cache's samples and leaves it at `point`, through `profile`, summed by `settings->method`.
+ * cache's samples and leaves it at `point`, through the plan's profile, by its method.
  *
- * Fails with `LUCENT_INVALID_ARGUMENT` for a non-finite position, a negative or non-finite
- * irradiance, local integral or setting, or an unknown method; `LUCENT_UNSUPPORTED` for
- * edge-refined; `LUCENT_NULL_POINTER` for a NULL argument. `*out` is written only on success.
+ * Fails with `LUCENT_INVALID_ARGUMENT` for a non-finite position or a negative or
+ * non-finite irradiance; `LUCENT_NULL_POINTER` for a NULL argument. `*out` is written only on
+ * success.
  *
  * # Safety
  *
- * `profile` and `cache` are NULL or live handles; `settings` and `point` are NULL or point to
- * their structs; `out` is NULL or valid for writing a `LucentExitance`.
+ * `query` and `cache` are NULL or live handles; `point` is NULL or points to a
+ * `LucentShadingPoint`; `out` is NULL or valid for writing a `LucentExitance`.
  */
-enum LucentStatus lucent_query(const struct LucentProfile *profile,
-                               const struct LucentCache *cache,
-                               const struct LucentQuerySettings *settings,
-                               const struct LucentShadingPoint *point,
-                               struct LucentExitance *out);
+enum LucentStatus lucent_query_point(const struct LucentQuery *query,
+                                     const struct LucentCache *cache,
+                                     const struct LucentShadingPoint *point,
+                                     struct LucentExitance *out);
 
 /**
- * `lucent_query` for `count` points: `out[i]` is the exitance at `points[i]`. Either every
- * query succeeds and all of `out` is written, or the call fails naming the first bad point
- * and `out` is left untouched. Runs on the calling thread; to use several cores, split the
- * points and call this from several threads on the same cache and profile. `points` and
+ * `lucent_query_point` for `count` points: `out[i]` is the exitance at `points[i]`. Either
+ * every query succeeds and all of `out` is written, or the call fails naming the first bad
+ * point and `out` is left untouched. Runs on the calling thread; to use several cores, split
+ * the points and call this from several threads with the same plan and cache. `points` and
  * `out` may be NULL when `count` is 0.
  *
  * # Safety
  *
- * `profile` and `cache` are NULL or live handles; `settings` is NULL or points to a
- * `LucentQuerySettings`; `points` is NULL or `count` readable points; `out` is NULL or valid
- * for writing `count` `LucentExitance`s and does not overlap `points`.
+ * `query` and `cache` are NULL or live handles; `points` is NULL or `count` readable points;
+ * `out` is NULL or valid for writing `count` `LucentExitance`s and does not overlap `points`.
  */
-enum LucentStatus lucent_query_many(const struct LucentProfile *profile,
-                                    const struct LucentCache *cache,
-                                    const struct LucentQuerySettings *settings,
-                                    const struct LucentShadingPoint *points,
-                                    size_t count,
-                                    struct LucentExitance *out);
+enum LucentStatus lucent_query_points(const struct LucentQuery *query,
+                                      const struct LucentCache *cache,
+                                      const struct LucentShadingPoint *points,
+                                      size_t count,
+                                      struct LucentExitance *out);
 
 /**
  * The message of the last failed `lucent_*` call on the calling thread, or "" if that call

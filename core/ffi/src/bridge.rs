@@ -10,11 +10,11 @@ use lucent_core::{
 
 use crate::status::{Failure, LucentStatus};
 use crate::types::{
-    LucentCoefficients, LucentExitance, LucentMethod, LucentQuerySettings, LucentSample,
+    LucentCoefficients, LucentExitance, LucentMethod, LucentQueryOptions, LucentSample,
     LucentShadingPoint,
 };
 
-/// The edge-refined method's value in `LucentQuerySettings.method` (not offered).
+/// The edge-refined method's value in `LucentQueryOptions.method` (not offered).
 const EDGE_REFINED: u32 = 4;
 
 /// A diffusion profile (the inside of a `LucentProfile` handle).
@@ -25,6 +25,15 @@ pub(crate) struct Material(Profile);
 /// `Sync`: queries from many threads at once need no lock.
 #[derive(Debug)]
 pub(crate) struct Cache(IrradianceCache);
+
+/// A query plan (the inside of a `LucentQuery` handle): the profile, the core's settings, and
+/// the local integral K that belongs to their smoothing radius α. Immutable once made.
+#[derive(Clone, Debug)]
+pub(crate) struct Plan {
+    profile: Profile,
+    settings: QuerySettings,
+    local_integral: Vec3,
+}
 
 fn invalid(error: impl std::fmt::Display) -> Failure {
     Failure::invalid(error.to_string())
@@ -120,50 +129,75 @@ impl Cache {
     pub(crate) fn smoothing_radius(&self, k: f32) -> f32 {
         self.0.smoothing_radius(k)
     }
+}
+
+impl Plan {
+    /// Settings from the options, with α = k·√Ā of `cache` and, for local-global and
+    /// edge-aware, K for `material` and α (zero for the others).
+    pub(crate) fn new(
+        material: &Material,
+        cache: &Cache,
+        options: &LucentQueryOptions,
+    ) -> Result<Plan, Failure> {
+        let method = method(options.method)?;
+        let factor = options.smoothing_factor;
+        if !(factor.is_finite() && factor >= 0.0) {
+            return Err(Failure::invalid(format!(
+                "smoothing_factor must be finite and non-negative, got {factor}"
+            )));
+        }
+        let alpha = cache.smoothing_radius(factor);
+        let local_integral = if method.is_split() {
+            if !(alpha > 0.0) {
+                return Err(Failure::invalid(format!(
+                    "the {} method needs a positive smoothing radius, got {alpha} \
+                     (smoothing_factor {factor} times the square root of the mean sample \
+                     area {})",
+                    method.name(),
+                    cache.mean_area()
+                )));
+            }
+            Vec3::from_array(material.local_integral(alpha)?)
+        } else {
+            Vec3::ZERO
+        };
+        let settings = QuerySettings {
+            method,
+            epsilon: options.epsilon,
+            cull_tolerance: options.cull_tolerance,
+            smoothing_radius: alpha,
+        };
+        settings.validate().map_err(invalid)?;
+        Ok(Plan {
+            profile: material.0,
+            settings,
+            local_integral,
+        })
+    }
+
+    /// The smoothing radius α.
+    pub(crate) fn smoothing_radius(&self) -> f32 {
+        self.settings.smoothing_radius
+    }
+
+    /// The local integral K per channel (zero for the methods without a local term).
+    pub(crate) fn local_integral(&self) -> [f32; 3] {
+        self.local_integral.to_array()
+    }
 
     /// One query.
     pub(crate) fn query(
         &self,
-        material: &Material,
-        settings: &LucentQuerySettings,
-        point: &LucentShadingPoint,
-    ) -> Result<LucentExitance, Failure> {
-        let (core_settings, k) = core_settings(settings)?;
-        self.query_with(material, &core_settings, k, point)
-    }
-
-    /// Many queries with the same settings, into `out` (same length as `points`).
-    pub(crate) fn query_many(
-        &self,
-        material: &Material,
-        settings: &LucentQuerySettings,
-        points: &[LucentShadingPoint],
-    ) -> Result<Vec<LucentExitance>, Failure> {
-        let (core_settings, k) = core_settings(settings)?;
-        points
-            .iter()
-            .enumerate()
-            .map(|(i, point)| {
-                self.query_with(material, &core_settings, k, point)
-                    .map_err(|f| Failure::invalid(format!("point {i}: {}", f.message)))
-            })
-            .collect()
-    }
-
-    fn query_with(
-        &self,
-        material: &Material,
-        settings: &QuerySettings,
-        k: Vec3,
+        cache: &Cache,
         point: &LucentShadingPoint,
     ) -> Result<LucentExitance, Failure> {
         let point = ShadingPoint {
             position: Vec3::from_array(point.position),
             irradiance: Vec3::from_array(point.irradiance),
         };
-        let m = self
+        let m = cache
             .0
-            .query(&material.0, &point, k, settings)
+            .query(&self.profile, &point, self.local_integral, &self.settings)
             .map_err(invalid)?;
         Ok(LucentExitance {
             total: m.total.to_array(),
@@ -171,6 +205,22 @@ impl Cache {
             global: m.global.to_array(),
             local_irradiance: m.local_irradiance.to_array(),
         })
+    }
+
+    /// Many queries, all or nothing: the first failure names its point.
+    pub(crate) fn query_many(
+        &self,
+        cache: &Cache,
+        points: &[LucentShadingPoint],
+    ) -> Result<Vec<LucentExitance>, Failure> {
+        points
+            .iter()
+            .enumerate()
+            .map(|(i, point)| {
+                self.query(cache, point)
+                    .map_err(|f| Failure::invalid(format!("point {i}: {}", f.message)))
+            })
+            .collect()
     }
 }
 
@@ -214,55 +264,15 @@ pub(crate) fn method_from_name(name: &str) -> Result<LucentMethod, Failure> {
     })
 }
 
-/// The core's settings and K from the C struct.
-fn core_settings(s: &LucentQuerySettings) -> Result<(QuerySettings, Vec3), Failure> {
-    let settings = QuerySettings {
-        method: method(s.method)?,
-        epsilon: s.epsilon,
-        cull_tolerance: s.cull_tolerance,
-        smoothing_radius: s.smoothing_radius,
-    };
-    settings.validate().map_err(invalid)?;
-    Ok((settings, Vec3::from_array(s.local_integral)))
-}
-
-/// Settings for `method` with the core's defaults, α = k·√Ā of `cache`, and K for
-/// `material` and α when the method has a local term (zero otherwise).
-pub(crate) fn settings_for(
-    material: &Material,
-    cache: &Cache,
-    method_value: u32,
-    smoothing_factor: f32,
-) -> Result<LucentQuerySettings, Failure> {
-    let method = method(method_value)?;
-    if !(smoothing_factor.is_finite() && smoothing_factor >= 0.0) {
-        return Err(Failure::invalid(format!(
-            "smoothing_factor must be finite and non-negative, got {smoothing_factor}"
-        )));
-    }
+/// The core's defaults, for `lucent_query_options_init`.
+pub(crate) fn default_options() -> LucentQueryOptions {
     let defaults = QuerySettings::default();
-    let alpha = cache.smoothing_radius(smoothing_factor);
-    let k = if method.is_split() {
-        if !(alpha > 0.0) {
-            return Err(Failure::invalid(format!(
-                "the {} method needs a positive smoothing radius, got {alpha} \
-                 (smoothing_factor {smoothing_factor} times the square root of the mean \
-                 sample area {})",
-                method.name(),
-                cache.mean_area()
-            )));
-        }
-        material.local_integral(alpha)?
-    } else {
-        [0.0; 3]
-    };
-    Ok(LucentQuerySettings {
-        method: method_value,
+    LucentQueryOptions {
+        method: LucentMethod::LUCENT_METHOD_EDGE_AWARE as u32,
+        smoothing_factor: 2.0,
         epsilon: defaults.epsilon,
         cull_tolerance: defaults.cull_tolerance,
-        smoothing_radius: alpha,
-        local_integral: k,
-    })
+    }
 }
 
 /// The core's own `Sample` must stay the seven floats `LucentSample` mirrors.

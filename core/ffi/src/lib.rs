@@ -16,7 +16,7 @@
 //! - no panic crosses the boundary: one is caught and reported as `LUCENT_PANIC`.
 //!
 //! The handles are immutable once made, so any number of threads may query one cache with
-//! one profile at once.
+//! one plan at once.
 //!
 //! Every call into lucent-core goes through one module (`bridge`), so that the C interface
 //! stays put while the core's Rust API moves.
@@ -40,10 +40,12 @@ pub use profile::{
     lucent_profile_radiance, lucent_profile_total_reflectance,
 };
 pub use query::{
-    lucent_method_from_name, lucent_query, lucent_query_many, lucent_query_settings_init,
+    LucentQuery, lucent_method_from_name, lucent_query_free, lucent_query_local_integral,
+    lucent_query_new, lucent_query_options_init, lucent_query_point, lucent_query_points,
+    lucent_query_smoothing_radius,
 };
 pub use status::{LucentStatus, lucent_last_error_message};
 pub use types::{
-    LucentCoefficients, LucentExitance, LucentMethod, LucentQuerySettings, LucentSample,
+    LucentCoefficients, LucentExitance, LucentMethod, LucentQueryOptions, LucentSample,
     LucentShadingPoint,
 };

@@ -82,8 +82,7 @@ pub unsafe extern "C" fn lucent_profile_from_coefficients(
     })
 }
 
-/// Frees a profile. NULL is a no-op. Caches and settings made with it stay valid (they do not
-/// refer to it).
+/// Frees a profile. NULL is a no-op. Query plans made with it stay valid (they copy it).
 ///
 /// # Safety
 ///
@@ -152,9 +151,9 @@ pub unsafe extern "C" fn lucent_profile_mean_free_path(
 }
 
 /// Writes the local integral K per RGB channel for smoothing radius `alpha` (scene units,
-/// finite and > 0) to `out[0..3]`: what `LucentQuerySettings.local_integral` must hold for
-/// `smoothing_radius = alpha` (`lucent_query_settings_init` computes it for you). Costs a few
-/// numerical quadratures: compute it once per profile and radius, not per query.
+/// finite and > 0) to `out[0..3]`: the fraction of a uniform irradiance that the local term of
+/// local-global and edge-aware gathers within α (`lucent_query_new` computes it for its plan).
+/// Costs a few numerical quadratures.
 ///
 /// # Safety
 ///

@@ -69,7 +69,7 @@ pub struct LucentCoefficients {
     pub eta: f32,
 }
 
-/// Which sum a query evaluates (`LucentQuerySettings.method`). The value 4 is the
+/// Which sum a query evaluates (`LucentQueryOptions.method`). The value 4 is the
 /// edge-refined method, which needs irradiance evaluated by the caller at quadrature points the
 /// query picks; the C interface does not offer it and answers `LUCENT_UNSUPPORTED`.
 #[repr(C)]
@@ -87,24 +87,20 @@ pub enum LucentMethod {
     LUCENT_METHOD_EXHAUSTIVE = 3,
 }
 
-/// How to query. Fill it with `lucent_query_settings_init`, which computes the smoothing
-/// radius and the local integral K that belong together; `epsilon` and `cull_tolerance` may
-/// then be changed freely. After changing `smoothing_radius`, recompute `local_integral` with
-/// `lucent_profile_local_integral` for the new radius.
+/// How to query: the input of `lucent_query_new`. `lucent_query_options_init` fills in the
+/// defaults (edge-aware, smoothing factor 2, ε = 0.05, cull tolerance 1e-4).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct LucentQuerySettings {
+pub struct LucentQueryOptions {
     /// A `LucentMethod` value.
     pub method: u32,
+    /// k in the smoothing radius α = k·√Ā of local-global and edge-aware (Ā the cache's mean
+    /// sample area; N10 suggests 1 to 4), finite and ≥ 0. Ignored by the other methods.
+    pub smoothing_factor: f32,
     /// JB02's solid-angle threshold ε: a node is aggregated when A/|x − P|² < ε (0 = never).
-    /// Default 0.05.
     pub epsilon: f32,
-    /// Relative tolerance for skipping negligible subtrees (0 = never). Default 1e-4.
+    /// Relative tolerance for skipping negligible subtrees (0 = never).
     pub cull_tolerance: f32,
-    /// Smoothing radius α (scene units) of local-global and edge-aware.
-    pub smoothing_radius: f32,
-    /// The local integral K per channel for this profile and `smoothing_radius`.
-    pub local_integral: [f32; 3],
 }
 
 const _: () = {
@@ -114,6 +110,6 @@ const _: () = {
     assert!(size_of::<LucentShadingPoint>() == 6 * size_of::<f32>());
     assert!(size_of::<LucentExitance>() == 12 * size_of::<f32>());
     assert!(size_of::<LucentCoefficients>() == 7 * size_of::<f32>());
-    assert!(size_of::<LucentQuerySettings>() == 7 * size_of::<f32>());
+    assert!(size_of::<LucentQueryOptions>() == 4 * size_of::<f32>());
     assert!(size_of::<LucentMethod>() == size_of::<core::ffi::c_int>());
 };

@@ -117,4 +117,5 @@ fn the_handles_are_shareable_across_threads() {
     fn shareable<T: Send + Sync>() {}
     shareable::<LucentCache>();
     shareable::<LucentProfile>();
+    shareable::<LucentQuery>();
 }

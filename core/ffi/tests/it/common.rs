@@ -99,17 +99,61 @@ pub fn patch(half: f32, h: f32, e: [f32; 3]) -> Vec<LucentSample> {
     samples
 }
 
-/// Settings from `lucent_query_settings_init`, or the failing status.
-pub fn settings(
+/// A query plan freed on drop.
+pub struct Query(pub *mut LucentQuery);
+
+impl Drop for Query {
+    fn drop(&mut self) {
+        // SAFETY: the handle came from the library and is freed exactly once, here.
+        unsafe { lucent_query_free(self.0) }
+    }
+}
+
+/// The default options with another method and smoothing factor.
+pub fn options(method: u32, smoothing_factor: f32) -> LucentQueryOptions {
+    let mut out = LucentQueryOptions::default();
+    // SAFETY: a writable struct.
+    let status = unsafe { lucent_query_options_init(&mut out) };
+    assert_eq!(status, LucentStatus::LUCENT_OK);
+    LucentQueryOptions {
+        method,
+        smoothing_factor,
+        ..out
+    }
+}
+
+/// A plan from `lucent_query_new`, or the failing status.
+pub fn plan_with(
     profile: &Profile,
     cache: &Cache,
-    method: u32,
-    factor: f32,
-) -> Result<LucentQuerySettings, LucentStatus> {
-    let mut out = LucentQuerySettings::default();
-    // SAFETY: live handles and a writable struct.
-    let status =
-        unsafe { lucent_query_settings_init(profile.0, cache.0, method, factor, &mut out) };
+    options: &LucentQueryOptions,
+) -> Result<Query, LucentStatus> {
+    let mut out = ptr::null_mut();
+    // SAFETY: live handles, a live struct and a writable out pointer.
+    let status = unsafe { lucent_query_new(profile.0, cache.0, options, &mut out) };
+    if status == LucentStatus::LUCENT_OK {
+        assert!(!out.is_null());
+        Ok(Query(out))
+    } else {
+        assert!(out.is_null(), "a failed creation leaves NULL in *out");
+        Err(status)
+    }
+}
+
+/// A plan for `method` with smoothing factor `k` and the other options at their defaults.
+pub fn plan(profile: &Profile, cache: &Cache, method: u32, k: f32) -> Result<Query, LucentStatus> {
+    plan_with(profile, cache, &options(method, k))
+}
+
+/// One query, or the failing status.
+pub fn query(
+    plan: &Query,
+    cache: &Cache,
+    point: &LucentShadingPoint,
+) -> Result<LucentExitance, LucentStatus> {
+    let mut out = LucentExitance::default();
+    // SAFETY: live handles, a live struct and a writable result.
+    let status = unsafe { lucent_query_point(plan.0, cache.0, point, &mut out) };
     if status == LucentStatus::LUCENT_OK {
         Ok(out)
     } else {
@@ -117,21 +161,18 @@ pub fn settings(
     }
 }
 
-/// One query, or the failing status.
-pub fn query(
-    profile: &Profile,
-    cache: &Cache,
-    settings: &LucentQuerySettings,
-    point: &LucentShadingPoint,
-) -> Result<LucentExitance, LucentStatus> {
-    let mut out = LucentExitance::default();
-    // SAFETY: live handles, live structs and a writable result.
-    let status = unsafe { lucent_query(profile.0, cache.0, settings, point, &mut out) };
-    if status == LucentStatus::LUCENT_OK {
-        Ok(out)
-    } else {
-        Err(status)
-    }
+/// A plan's α and K.
+pub fn alpha_and_k(plan: &Query) -> (f32, [f32; 3]) {
+    let (mut alpha, mut k) = (f32::NAN, [f32::NAN; 3]);
+    // SAFETY: a live plan, a writable float and three writable floats.
+    let statuses = unsafe {
+        [
+            lucent_query_smoothing_radius(plan.0, &mut alpha),
+            lucent_query_local_integral(plan.0, k.as_mut_ptr()),
+        ]
+    };
+    assert_eq!(statuses, [LucentStatus::LUCENT_OK; 2]);
+    (alpha, k)
 }
 
 /// Relative error |a − b| / |b| per channel, the largest.

@@ -6,7 +6,7 @@ use std::ptr::{null, null_mut};
 
 use lucent_ffi::*;
 
-use crate::common::{build, coefficients, message, patch, preset, query, settings};
+use crate::common::{build, coefficients, message, options, patch, plan, plan_with, preset, query};
 
 use LucentStatus::{
     LUCENT_INVALID_ARGUMENT, LUCENT_NULL_POINTER, LUCENT_UNKNOWN_PRESET, LUCENT_UNSUPPORTED,
@@ -27,7 +27,7 @@ fn fails(status: LucentStatus, want: LucentStatus, says: &str) {
 fn every_pointer_argument_is_checked_for_null() {
     let skin = preset("skin1", 1.0).unwrap();
     let cache = build(&patch(1.0, 0.25, [1.0; 3])).unwrap();
-    let s = settings(&skin, &cache, 2, 2.0).unwrap();
+    let q = plan(&skin, &cache, 2, 2.0).unwrap();
     let point = LucentShadingPoint::default();
     let name = CString::new("marble").unwrap();
     let c = LucentCoefficients {
@@ -35,165 +35,140 @@ fn every_pointer_argument_is_checked_for_null() {
         sigma_s_prime: [1.0; 3],
         eta: 1.3,
     };
+    let o = options(2, 2.0);
     let mut profile_out: *mut LucentProfile = null_mut();
     let mut cache_out: *mut LucentCache = null_mut();
+    let mut query_out: *mut LucentQuery = null_mut();
     let mut floats = [0.0f32; 3];
     let mut size = 0usize;
     let mut alpha = 0.0f32;
     let mut method = LucentMethod::LUCENT_METHOD_EDGE_AWARE;
-    let mut qs = LucentQuerySettings::default();
     let mut m = LucentExitance::default();
     let mut ms = [LucentExitance::default(); 1];
     let f = floats.as_mut_ptr();
+    let e = [1.0f32; 3].as_ptr();
     let one = LucentSample::default();
-    let (p, k) = (skin.0.cast_const(), cache.0.cast_const());
+    let (p, k, qp) = (skin.0.cast_const(), cache.0.cast_const(), q.0.cast_const());
+    // Each call, then its message, which names the NULL argument.
+    let check = |status: LucentStatus, says: &str| fails(status, LUCENT_NULL_POINTER, says);
     // SAFETY: every pointer is NULL or valid for what the function reads or writes.
-    let cases: Vec<(LucentStatus, &str)> = unsafe {
-        vec![
-            (
-                lucent_profile_from_preset(null(), 1.0, &mut profile_out),
-                "name is NULL",
-            ),
-            (
-                lucent_profile_from_preset(name.as_ptr(), 1.0, null_mut()),
-                "out is NULL",
-            ),
-            (
-                lucent_profile_from_coefficients(null(), &mut profile_out),
-                "coefficients is NULL",
-            ),
-            (
-                lucent_profile_from_coefficients(&c, null_mut()),
-                "out is NULL",
-            ),
-            (
-                lucent_profile_total_reflectance(null(), f),
-                "profile is NULL",
-            ),
-            (
-                lucent_profile_total_reflectance(p, null_mut()),
-                "out is NULL",
-            ),
-            (lucent_profile_mean_free_path(null(), f), "profile is NULL"),
-            (lucent_profile_mean_free_path(p, null_mut()), "out is NULL"),
-            (
-                lucent_profile_local_integral(null(), 1.0, f),
-                "profile is NULL",
-            ),
-            (
-                lucent_profile_local_integral(p, 1.0, null_mut()),
-                "out is NULL",
-            ),
-            (
-                lucent_profile_radiance(null(), [1.0f32; 3].as_ptr(), 1.0, f),
-                "profile is NULL",
-            ),
-            (
-                lucent_profile_radiance(p, null(), 1.0, f),
-                "exitance is NULL",
-            ),
-            (
-                lucent_profile_radiance(p, [1.0f32; 3].as_ptr(), 1.0, null_mut()),
-                "out is NULL",
-            ),
-            (
-                lucent_cache_build(null(), 1, &mut cache_out),
-                "samples is NULL",
-            ),
-            (lucent_cache_build(&one, 1, null_mut()), "out is NULL"),
-            (lucent_cache_len(null(), &mut size), "cache is NULL"),
-            (lucent_cache_len(k, null_mut()), "out is NULL"),
-            (
-                lucent_cache_smoothing_radius(null(), 1.0, &mut alpha),
-                "cache is NULL",
-            ),
-            (
-                lucent_cache_smoothing_radius(k, 1.0, null_mut()),
-                "out is NULL",
-            ),
-            (lucent_method_from_name(null(), &mut method), "name is NULL"),
-            (
-                lucent_method_from_name(name.as_ptr(), null_mut()),
-                "out is NULL",
-            ),
-            (
-                lucent_query_settings_init(null(), k, 2, 2.0, &mut qs),
-                "profile is NULL",
-            ),
-            (
-                lucent_query_settings_init(p, null(), 2, 2.0, &mut qs),
-                "cache is NULL",
-            ),
-            (
-                lucent_query_settings_init(p, k, 2, 2.0, null_mut()),
-                "out is NULL",
-            ),
-            (
-                lucent_query(null(), k, &s, &point, &mut m),
-                "profile is NULL",
-            ),
-            (lucent_query(p, null(), &s, &point, &mut m), "cache is NULL"),
-            (
-                lucent_query(p, k, null(), &point, &mut m),
-                "settings is NULL",
-            ),
-            (lucent_query(p, k, &s, null(), &mut m), "point is NULL"),
-            (lucent_query(p, k, &s, &point, null_mut()), "out is NULL"),
-            (
-                lucent_query_many(null(), k, &s, &point, 1, ms.as_mut_ptr()),
-                "profile is NULL",
-            ),
-            (
-                lucent_query_many(p, null(), &s, &point, 1, ms.as_mut_ptr()),
-                "cache is NULL",
-            ),
-            (
-                lucent_query_many(p, k, null(), &point, 1, ms.as_mut_ptr()),
-                "settings is NULL",
-            ),
-            (
-                lucent_query_many(p, k, &s, null(), 1, ms.as_mut_ptr()),
-                "points is NULL",
-            ),
-            (
-                lucent_query_many(p, k, &s, &point, 1, null_mut()),
-                "out is NULL",
-            ),
-        ]
-    };
-    // Each status was recorded right after its call, but the message is per call: check the
-    // statuses here and each message by calling again below.
-    for (i, (status, says)) in cases.iter().enumerate() {
-        assert_eq!(*status, LUCENT_NULL_POINTER, "case {i}: {says}");
-    }
-    // The messages, one call at a time.
-    // SAFETY: as above.
     unsafe {
-        fails(
-            lucent_query_many(p, k, &s, null(), 1, ms.as_mut_ptr()),
-            LUCENT_NULL_POINTER,
-            "points is NULL",
+        check(
+            lucent_profile_from_preset(null(), 1.0, &mut profile_out),
+            "name is NULL",
         );
-        fails(
-            lucent_query(p, k, &s, null(), &mut m),
-            LUCENT_NULL_POINTER,
-            "point is NULL",
+        check(
+            lucent_profile_from_preset(name.as_ptr(), 1.0, null_mut()),
+            "out is NULL",
         );
-        fails(
+        check(
+            lucent_profile_from_coefficients(null(), &mut profile_out),
+            "coefficients is NULL",
+        );
+        check(
+            lucent_profile_from_coefficients(&c, null_mut()),
+            "out is NULL",
+        );
+        check(
+            lucent_profile_total_reflectance(null(), f),
+            "profile is NULL",
+        );
+        check(
+            lucent_profile_total_reflectance(p, null_mut()),
+            "out is NULL",
+        );
+        check(lucent_profile_mean_free_path(null(), f), "profile is NULL");
+        check(lucent_profile_mean_free_path(p, null_mut()), "out is NULL");
+        check(
+            lucent_profile_local_integral(null(), 1.0, f),
+            "profile is NULL",
+        );
+        check(
+            lucent_profile_local_integral(p, 1.0, null_mut()),
+            "out is NULL",
+        );
+        check(
+            lucent_profile_radiance(null(), e, 1.0, f),
+            "profile is NULL",
+        );
+        check(
             lucent_profile_radiance(p, null(), 1.0, f),
-            LUCENT_NULL_POINTER,
             "exitance is NULL",
         );
-        fails(
-            lucent_cache_len(null(), &mut size),
-            LUCENT_NULL_POINTER,
+        check(
+            lucent_profile_radiance(p, e, 1.0, null_mut()),
+            "out is NULL",
+        );
+        check(
+            lucent_cache_build(null(), 1, &mut cache_out),
+            "samples is NULL",
+        );
+        check(lucent_cache_build(&one, 1, null_mut()), "out is NULL");
+        check(lucent_cache_len(null(), &mut size), "cache is NULL");
+        check(lucent_cache_len(k, null_mut()), "out is NULL");
+        check(
+            lucent_cache_smoothing_radius(null(), 1.0, &mut alpha),
             "cache is NULL",
         );
+        check(
+            lucent_cache_smoothing_radius(k, 1.0, null_mut()),
+            "out is NULL",
+        );
+        check(lucent_method_from_name(null(), &mut method), "name is NULL");
+        check(
+            lucent_method_from_name(name.as_ptr(), null_mut()),
+            "out is NULL",
+        );
+        check(lucent_query_options_init(null_mut()), "out is NULL");
+        check(
+            lucent_query_new(null(), k, &o, &mut query_out),
+            "profile is NULL",
+        );
+        check(
+            lucent_query_new(p, null(), &o, &mut query_out),
+            "cache is NULL",
+        );
+        check(
+            lucent_query_new(p, k, null(), &mut query_out),
+            "options is NULL",
+        );
+        check(lucent_query_new(p, k, &o, null_mut()), "out is NULL");
+        check(
+            lucent_query_smoothing_radius(null(), &mut alpha),
+            "query is NULL",
+        );
+        check(lucent_query_smoothing_radius(qp, null_mut()), "out is NULL");
+        check(lucent_query_local_integral(null(), f), "query is NULL");
+        check(lucent_query_local_integral(qp, null_mut()), "out is NULL");
+        check(
+            lucent_query_point(null(), k, &point, &mut m),
+            "query is NULL",
+        );
+        check(
+            lucent_query_point(qp, null(), &point, &mut m),
+            "cache is NULL",
+        );
+        check(lucent_query_point(qp, k, null(), &mut m), "point is NULL");
+        check(lucent_query_point(qp, k, &point, null_mut()), "out is NULL");
+        let out = ms.as_mut_ptr();
+        check(
+            lucent_query_points(null(), k, &point, 1, out),
+            "query is NULL",
+        );
+        check(
+            lucent_query_points(qp, null(), &point, 1, out),
+            "cache is NULL",
+        );
+        check(lucent_query_points(qp, k, null(), 1, out), "points is NULL");
+        check(
+            lucent_query_points(qp, k, &point, 1, null_mut()),
+            "out is NULL",
+        );
     }
-    assert!(profile_out.is_null() && cache_out.is_null());
+    assert!(profile_out.is_null() && cache_out.is_null() && query_out.is_null());
     // Zero-length batches accept NULL arrays.
     // SAFETY: count 0 with NULL arrays is allowed.
-    let status = unsafe { lucent_query_many(p, k, &s, null(), 0, null_mut()) };
+    let status = unsafe { lucent_query_points(qp, k, null(), 0, null_mut()) };
     assert_eq!(status, LucentStatus::LUCENT_OK);
 }
 
@@ -245,7 +220,6 @@ fn out_of_range_numbers_name_the_argument() {
     let (p, k) = (skin.0.cast_const(), cache.0.cast_const());
     let mut out = [0.0f32; 3];
     let mut alpha = 0.0;
-    let mut qs = LucentQuerySettings::default();
     // SAFETY: live handles and writable outputs throughout.
     unsafe {
         fails(
@@ -268,74 +242,65 @@ fn out_of_range_numbers_name_the_argument() {
             LUCENT_INVALID_ARGUMENT,
             "factor must be finite and non-negative, got -1",
         );
-        fails(
-            lucent_query_settings_init(p, k, 2, f32::INFINITY, &mut qs),
-            LUCENT_INVALID_ARGUMENT,
-            "smoothing_factor must be finite and non-negative, got inf",
-        );
-        fails(
-            lucent_query_settings_init(p, k, 2, 0.0, &mut qs),
-            LUCENT_INVALID_ARGUMENT,
-            "the edge-aware method needs a positive smoothing radius",
-        );
-        fails(
-            lucent_query_settings_init(p, k, 9, 2.0, &mut qs),
-            LUCENT_INVALID_ARGUMENT,
-            "method 9 is not a LucentMethod (0 to 3)",
-        );
     }
-    assert_eq!(
-        qs,
-        LucentQuerySettings::default(),
-        "failures write no settings"
-    );
+    for (o, says) in [
+        (
+            options(2, f32::INFINITY),
+            "smoothing_factor must be finite and non-negative, got inf",
+        ),
+        (
+            options(2, 0.0),
+            "the edge-aware method needs a positive smoothing radius",
+        ),
+        (options(9, 2.0), "method 9 is not a LucentMethod (0 to 3)"),
+        (
+            LucentQueryOptions {
+                epsilon: -0.1,
+                ..options(2, 2.0)
+            },
+            "epsilon must be finite and non-negative, got -0.1",
+        ),
+        (
+            LucentQueryOptions {
+                cull_tolerance: f32::NAN,
+                ..options(0, 2.0)
+            },
+            "cull_tolerance must be finite",
+        ),
+    ] {
+        assert_eq!(
+            plan_with(&skin, &cache, &o).err(),
+            Some(LUCENT_INVALID_ARGUMENT)
+        );
+        assert!(message().contains(says), "{} vs {says}", message());
+    }
 
-    let s = settings(&skin, &cache, 2, 2.0).unwrap();
+    let q = plan(&skin, &cache, 2, 2.0).unwrap();
     let point = LucentShadingPoint {
         position: [0.0; 3],
         irradiance: [1.0; 3],
     };
-    for (bad_settings, bad_point, says) in [
+    for (bad_point, says) in [
         (
-            LucentQuerySettings { epsilon: -0.1, ..s },
-            point,
-            "epsilon must be finite and non-negative, got -0.1",
-        ),
-        (
-            LucentQuerySettings {
-                cull_tolerance: f32::NAN,
-                ..s
-            },
-            point,
-            "cull_tolerance must be finite",
-        ),
-        (
-            LucentQuerySettings {
-                local_integral: [0.1, -0.1, 0.1],
-                ..s
-            },
-            point,
-            "local integral K must be finite and non-negative",
-        ),
-        (
-            LucentQuerySettings { method: 77, ..s },
-            point,
-            "method 77 is not a LucentMethod",
-        ),
-        (
-            s,
             LucentShadingPoint {
                 position: [f32::INFINITY, 0.0, 0.0],
                 ..point
             },
             "shading position is not finite",
         ),
+        (
+            LucentShadingPoint {
+                irradiance: [1.0, f32::NAN, 1.0],
+                ..point
+            },
+            "irradiance at the shading point must be finite and non-negative",
+        ),
     ] {
         assert_eq!(
-            query(&skin, &cache, &bad_settings, &bad_point).err(),
+            query(&q, &cache, &bad_point).err(),
             Some(LUCENT_INVALID_ARGUMENT)
         );
-        assert!(message().contains(says), "{} vs {says}", message());
+        assert_eq!(message(), says);
     }
 }
 
@@ -375,19 +340,10 @@ fn unknown_and_unsupported_names_have_their_own_statuses() {
         "failures write nothing"
     );
 
-    // The edge-refined value itself, in the settings or to the initialiser.
+    // The edge-refined value itself.
     let skin = preset("skin1", 1.0).unwrap();
     let cache = build(&patch(1.0, 0.25, [1.0; 3])).unwrap();
-    assert_eq!(settings(&skin, &cache, 4, 2.0), Err(LUCENT_UNSUPPORTED));
-    let s = LucentQuerySettings {
-        method: 4,
-        ..settings(&skin, &cache, 2, 2.0).unwrap()
-    };
-    let point = LucentShadingPoint::default();
-    assert_eq!(
-        query(&skin, &cache, &s, &point).err(),
-        Some(LUCENT_UNSUPPORTED)
-    );
+    assert_eq!(plan(&skin, &cache, 4, 2.0).err(), Some(LUCENT_UNSUPPORTED));
     assert!(message().contains("use edge-aware"), "{}", message());
 }
 

@@ -9,7 +9,8 @@ use lucent_core::{
 use lucent_ffi::*;
 
 use crate::common::{
-    Cache, METHODS, Profile, build, message, patch, preset, query, rel_err, settings,
+    Cache, METHODS, Profile, alpha_and_k, build, message, options, patch, plan, plan_with, preset,
+    query, rel_err,
 };
 
 /// Skin1 at 1 mm per unit on an 80 × 80 mm patch, 0.5 mm apart, lit by E: the longest
@@ -38,12 +39,11 @@ fn every_method_gives_e_times_rd_total_on_a_lit_patch() {
     let rd = total_reflectance(&skin);
     let want = [e[0] * rd[0], e[1] * rd[1], e[2] * rd[2]];
     for method in METHODS {
-        let s = settings(&skin, &cache, method as u32, 2.0).unwrap();
+        let q = plan(&skin, &cache, method as u32, 2.0).unwrap();
         for position in [[0.0, 0.0, 0.0], [0.13, -0.21, 0.0], [1.1, 0.6, 0.0]] {
             let m = query(
-                &skin,
+                &q,
                 &cache,
-                &s,
                 &LucentShadingPoint {
                     position,
                     irradiance: e,
@@ -87,7 +87,7 @@ fn the_c_interface_returns_what_the_core_computes() {
         Method::EdgeAware,
         Method::Exhaustive,
     ]) {
-        let s = settings(&skin, &cache, method as u32, 1.5).unwrap();
+        let q = plan(&skin, &cache, method as u32, 1.5).unwrap();
         let alpha = core_cache.smoothing_radius(1.5);
         let k = if core_method.is_split() {
             LocalIntegralTable::new(&profile, alpha, alpha / 1024.0)
@@ -96,15 +96,15 @@ fn the_c_interface_returns_what_the_core_computes() {
         } else {
             Vec3::ZERO
         };
-        assert_eq!(s.smoothing_radius, alpha);
-        assert_eq!(s.local_integral, k.to_array());
+        assert_eq!(alpha_and_k(&q), (alpha, k.to_array()));
         let core_settings = QuerySettings {
             method: core_method,
             smoothing_radius: alpha,
             ..QuerySettings::default()
         };
+        let o = options(method as u32, 1.5);
         assert_eq!(
-            (s.epsilon, s.cull_tolerance),
+            (o.epsilon, o.cull_tolerance),
             (core_settings.epsilon, core_settings.cull_tolerance)
         );
         // A shadow edge: half the point's own irradiance.
@@ -112,7 +112,7 @@ fn the_c_interface_returns_what_the_core_computes() {
             position: [2.5, -1.25, 0.0],
             irradiance: [0.35, 0.5, 0.65],
         };
-        let got = query(&skin, &cache, &s, &point).unwrap();
+        let got = query(&q, &cache, &point).unwrap();
         let want = core_cache
             .query(
                 &profile,
@@ -136,26 +136,46 @@ fn the_c_interface_returns_what_the_core_computes() {
 }
 
 #[test]
-fn settings_hold_the_defaults_alpha_and_k() {
+fn a_plan_holds_alpha_and_the_k_that_goes_with_it() {
     let (skin, cache) = lit_skin_patch([1.0; 3]);
-    let hierarchical = settings(&skin, &cache, 0, 2.0).unwrap();
-    assert_eq!(
-        hierarchical,
-        LucentQuerySettings {
-            method: 0,
-            epsilon: 0.05,
-            cull_tolerance: 1e-4,
-            smoothing_radius: 1.0, // 2·√(0.5²)
-            local_integral: [0.0; 3],
-        }
-    );
-    let edge_aware = settings(&skin, &cache, 2, 2.0).unwrap();
+    // Ā = 0.5², so α = 2·0.5 = 1.
+    let hierarchical = plan(&skin, &cache, 0, 2.0).unwrap();
+    assert_eq!(alpha_and_k(&hierarchical), (1.0, [0.0; 3]));
+    let edge_aware = plan(&skin, &cache, 2, 2.0).unwrap();
     let mut k = [0.0; 3];
     // SAFETY: a live profile and three writable floats.
     let status = unsafe { lucent_profile_local_integral(skin.0, 1.0, k.as_mut_ptr()) };
     assert_eq!(status, LucentStatus::LUCENT_OK);
-    assert_eq!(edge_aware.local_integral, k);
+    assert_eq!(alpha_and_k(&edge_aware), (1.0, k));
     assert!(k.iter().all(|&v| v > 0.0));
+    // The plan copies the profile: it outlives the handle.
+    drop(skin);
+    let point = LucentShadingPoint {
+        position: [0.0; 3],
+        irradiance: [1.0; 3],
+    };
+    assert!(query(&edge_aware, &cache, &point).is_ok());
+}
+
+#[test]
+fn the_default_options_are_the_cores() {
+    assert_eq!(
+        options(LucentMethod::LUCENT_METHOD_EDGE_AWARE as u32, 2.0),
+        {
+            let mut o = LucentQueryOptions::default();
+            // SAFETY: a writable struct.
+            let status = unsafe { lucent_query_options_init(&mut o) };
+            assert_eq!(status, LucentStatus::LUCENT_OK);
+            o
+        }
+    );
+    let core = QuerySettings::default();
+    let o = options(0, 0.0);
+    assert_eq!(
+        (o.epsilon, o.cull_tolerance),
+        (core.epsilon, core.cull_tolerance)
+    );
+    assert_eq!(core.method, Method::EdgeAware);
 }
 
 #[test]
@@ -183,14 +203,13 @@ fn many_points_at_once_equal_one_at_a_time() {
         })
         .collect();
     for method in METHODS {
-        let s = settings(&skin, &cache, method as u32, 2.0).unwrap();
+        let q = plan(&skin, &cache, method as u32, 2.0).unwrap();
         let mut out = vec![LucentExitance::default(); points.len()];
-        // SAFETY: live handles and settings, `points.len()` points and as many results.
+        // SAFETY: live handles, `points.len()` points and as many results.
         let status = unsafe {
-            lucent_query_many(
-                skin.0,
+            lucent_query_points(
+                q.0,
                 cache.0,
-                &s,
                 points.as_ptr(),
                 points.len(),
                 out.as_mut_ptr(),
@@ -198,7 +217,7 @@ fn many_points_at_once_equal_one_at_a_time() {
         };
         assert_eq!(status, LucentStatus::LUCENT_OK, "{}", message());
         for (p, m) in points.iter().zip(&out) {
-            assert_eq!(*m, query(&skin, &cache, &s, p).unwrap());
+            assert_eq!(*m, query(&q, &cache, p).unwrap());
         }
     }
 }
@@ -206,7 +225,7 @@ fn many_points_at_once_equal_one_at_a_time() {
 #[test]
 fn a_bad_point_fails_the_whole_batch_and_writes_nothing() {
     let (skin, cache) = lit_skin_patch([1.0; 3]);
-    let s = settings(&skin, &cache, 2, 2.0).unwrap();
+    let q = plan(&skin, &cache, 2, 2.0).unwrap();
     let mut points = [LucentShadingPoint {
         position: [0.0; 3],
         irradiance: [1.0; 3],
@@ -217,9 +236,8 @@ fn a_bad_point_fails_the_whole_batch_and_writes_nothing() {
         ..Default::default()
     };
     let mut out = [untouched; 5];
-    // SAFETY: live handles and settings, five points and five results.
-    let status =
-        unsafe { lucent_query_many(skin.0, cache.0, &s, points.as_ptr(), 5, out.as_mut_ptr()) };
+    // SAFETY: live handles, five points and five results.
+    let status = unsafe { lucent_query_points(q.0, cache.0, points.as_ptr(), 5, out.as_mut_ptr()) };
     assert_eq!(status, LucentStatus::LUCENT_INVALID_ARGUMENT);
     assert_eq!(
         message(),
@@ -232,30 +250,40 @@ fn a_bad_point_fails_the_whole_batch_and_writes_nothing() {
 fn an_empty_cache_gives_no_light_and_no_smoothing_radius() {
     let skin = preset("skin1", 1.0).unwrap();
     let cache = build(&[]).unwrap();
-    let s = settings(&skin, &cache, 0, 2.0).unwrap();
+    let q = plan(&skin, &cache, 0, 2.0).unwrap();
     let point = LucentShadingPoint {
         position: [0.0; 3],
         irradiance: [1.0; 3],
     };
     assert_eq!(
-        query(&skin, &cache, &s, &point).unwrap(),
+        query(&q, &cache, &point).unwrap(),
         LucentExitance::default()
     );
     assert_eq!(
-        settings(&skin, &cache, 2, 2.0),
-        Err(LucentStatus::LUCENT_INVALID_ARGUMENT)
+        plan(&skin, &cache, 2, 2.0).err(),
+        Some(LucentStatus::LUCENT_INVALID_ARGUMENT)
     );
     assert!(
         message().contains("needs a positive smoothing radius"),
         "{}",
         message()
     );
+    // Options other than the method and factor reach the core's validation too.
+    let negative = LucentQueryOptions {
+        epsilon: -1.0,
+        ..options(0, 2.0)
+    };
+    assert_eq!(
+        plan_with(&skin, &cache, &negative).err(),
+        Some(LucentStatus::LUCENT_INVALID_ARGUMENT)
+    );
+    assert_eq!(message(), "epsilon must be finite and non-negative, got -1");
 }
 
 #[test]
-fn threads_share_one_cache_and_profile() {
+fn threads_share_one_cache_and_plan() {
     let (skin, cache) = lit_skin_patch([1.0, 0.5, 0.25]);
-    let s = settings(&skin, &cache, 2, 2.0).unwrap();
+    let q = plan(&skin, &cache, 2, 2.0).unwrap();
     let points: Vec<LucentShadingPoint> = (0..64)
         .map(|i| LucentShadingPoint {
             position: [i as f32 * 0.5 - 16.0, 0.25, 0.0],
@@ -264,10 +292,10 @@ fn threads_share_one_cache_and_profile() {
         .collect();
     let serial: Vec<LucentExitance> = points
         .iter()
-        .map(|p| query(&skin, &cache, &s, p).unwrap())
+        .map(|p| query(&q, &cache, p).unwrap())
         .collect();
     // SAFETY: both handles are live until the end of this test, after the threads joined.
-    let (profile, shared) = unsafe { (&*skin.0, &*cache.0) };
+    let (shared_plan, shared_cache) = unsafe { (&*q.0, &*cache.0) };
     let parallel: Vec<LucentExitance> = std::thread::scope(|scope| {
         let halves: Vec<_> = points
             .chunks(32)
@@ -277,10 +305,9 @@ fn threads_share_one_cache_and_profile() {
                     // SAFETY: live handles (borrowed for the scope), `chunk.len()` points and
                     // as many results.
                     let status = unsafe {
-                        lucent_query_many(
-                            profile,
-                            shared,
-                            &s,
+                        lucent_query_points(
+                            shared_plan,
+                            shared_cache,
                             chunk.as_ptr(),
                             chunk.len(),
                             out.as_mut_ptr(),
