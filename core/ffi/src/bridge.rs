@@ -1,0 +1,279 @@
+//! Every call into lucent-core, and every core type the C interface stands on, is in this
+//! file: the rest of the crate speaks only the C structs of [`crate::types`] and the
+//! [`Material`] and [`Cache`] wrappers below, so that a change of the core's Rust API is a
+//! change here alone. Only the core's crate-root names are used.
+
+use lucent_core::glam::Vec3;
+use lucent_core::{
+    IrradianceCache, LocalIntegralTable, Method, Profile, QuerySettings, Sample, ShadingPoint,
+};
+
+use crate::status::{Failure, LucentStatus};
+use crate::types::{
+    LucentCoefficients, LucentExitance, LucentMethod, LucentQueryOptions, LucentSample,
+    LucentShadingPoint,
+};
+
+/// The edge-refined method's value in `LucentQueryOptions.method` (not offered).
+const EDGE_REFINED: u32 = 4;
+
+/// A diffusion profile (the inside of a `LucentProfile` handle).
+#[derive(Clone, Debug)]
+pub(crate) struct Material(Profile);
+
+/// An irradiance cache (the inside of a `LucentCache` handle). Immutable once built, and
+/// `Sync`: queries from many threads at once need no lock.
+#[derive(Debug)]
+pub(crate) struct Cache(IrradianceCache);
+
+/// A query plan (the inside of a `LucentQuery` handle): the profile, the core's settings, and
+/// the local integral K that belongs to their smoothing radius α. Immutable once made.
+#[derive(Clone, Debug)]
+pub(crate) struct Plan {
+    profile: Profile,
+    settings: QuerySettings,
+    local_integral: Vec3,
+}
+
+fn invalid(error: impl std::fmt::Display) -> Failure {
+    Failure::invalid(error.to_string())
+}
+
+impl Material {
+    /// A measured material by name (any ASCII case) at `mm_per_unit` millimetres per unit.
+    pub(crate) fn from_preset(name: &str, mm_per_unit: f32) -> Result<Material, Failure> {
+        let preset = lucent_core::presets::find(name).ok_or_else(|| {
+            Failure::new(
+                LucentStatus::LUCENT_UNKNOWN_PRESET,
+                format!("unknown material preset \"{name}\""),
+            )
+        })?;
+        Profile::from_preset(preset, mm_per_unit)
+            .map(Material)
+            .map_err(invalid)
+    }
+
+    /// From σ_a, σ_s′ (per scene unit) and η.
+    pub(crate) fn from_coefficients(c: &LucentCoefficients) -> Result<Material, Failure> {
+        Profile::from_coefficients(
+            Vec3::from_array(c.sigma_a),
+            Vec3::from_array(c.sigma_s_prime),
+            c.eta,
+        )
+        .map(Material)
+        .map_err(invalid)
+    }
+
+    /// Rd_total per channel: the albedo of a flat, uniformly lit surface.
+    pub(crate) fn total_reflectance(&self) -> [f32; 3] {
+        self.0.total_reflectance().to_array()
+    }
+
+    /// ℓ_u = 1/σ_t′ per channel.
+    pub(crate) fn mean_free_path(&self) -> [f32; 3] {
+        self.0.mean_free_path().to_array()
+    }
+
+    /// Radiance towards a viewer at cos θ_o from radiant exitance (`docs/physics.md` §17).
+    pub(crate) fn radiance(&self, exitance: [f32; 3], cos_out: f32) -> Result<[f32; 3], Failure> {
+        if !exitance.iter().all(|v| v.is_finite()) {
+            return Err(Failure::invalid(format!(
+                "exitance must be finite, got {exitance:?}"
+            )));
+        }
+        if !(0.0..=1.0).contains(&cos_out) {
+            return Err(Failure::invalid(format!(
+                "cos_out must lie in [0, 1], got {cos_out}"
+            )));
+        }
+        Ok(self
+            .0
+            .radiance(Vec3::from_array(exitance), cos_out)
+            .to_array())
+    }
+
+    /// The local integral K per channel for smoothing radius α (N10's table, looked up at
+    /// this profile's ℓ_u).
+    pub(crate) fn local_integral(&self, alpha: f32) -> Result<[f32; 3], Failure> {
+        let table = LocalIntegralTable::new(&self.0, alpha, alpha / 1024.0).map_err(invalid)?;
+        Ok(table.lookup(self.0.mean_free_path()).to_array())
+    }
+}
+
+impl Cache {
+    /// Builds a cache from samples in any order.
+    pub(crate) fn build(samples: &[LucentSample]) -> Result<Cache, Failure> {
+        let samples: Vec<Sample> = samples
+            .iter()
+            .map(|s| Sample {
+                position: Vec3::from_array(s.position),
+                area: s.area,
+                irradiance: Vec3::from_array(s.irradiance),
+            })
+            .collect();
+        let cache = IrradianceCache::build(&samples).map_err(invalid)?;
+        Ok(Cache(cache))
+    }
+
+    /// Number of samples.
+    pub(crate) fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Mean sample area Ā.
+    pub(crate) fn mean_area(&self) -> f32 {
+        self.0.mean_area()
+    }
+
+    /// α = k·√Ā.
+    pub(crate) fn smoothing_radius(&self, k: f32) -> f32 {
+        self.0.smoothing_radius(k)
+    }
+}
+
+impl Plan {
+    /// Settings from the options, with α = k·√Ā of `cache` and, for local-global and
+    /// edge-aware, K for `material` and α (zero for the others).
+    pub(crate) fn new(
+        material: &Material,
+        cache: &Cache,
+        options: &LucentQueryOptions,
+    ) -> Result<Plan, Failure> {
+        let method = method(options.method)?;
+        let factor = options.smoothing_factor;
+        if !(factor.is_finite() && factor >= 0.0) {
+            return Err(Failure::invalid(format!(
+                "smoothing_factor must be finite and non-negative, got {factor}"
+            )));
+        }
+        let alpha = cache.smoothing_radius(factor);
+        let local_integral = if method.is_split() {
+            if !(alpha > 0.0) {
+                return Err(Failure::invalid(format!(
+                    "the {} method needs a positive smoothing radius, got {alpha} \
+                     (smoothing_factor {factor} times the square root of the mean sample \
+                     area {})",
+                    method.name(),
+                    cache.mean_area()
+                )));
+            }
+            Vec3::from_array(material.local_integral(alpha)?)
+        } else {
+            Vec3::ZERO
+        };
+        let settings = QuerySettings {
+            method,
+            epsilon: options.epsilon,
+            cull_tolerance: options.cull_tolerance,
+            smoothing_radius: alpha,
+        };
+        settings.validate().map_err(invalid)?;
+        Ok(Plan {
+            profile: material.0,
+            settings,
+            local_integral,
+        })
+    }
+
+    /// The smoothing radius α.
+    pub(crate) fn smoothing_radius(&self) -> f32 {
+        self.settings.smoothing_radius
+    }
+
+    /// The local integral K per channel (zero for the methods without a local term).
+    pub(crate) fn local_integral(&self) -> [f32; 3] {
+        self.local_integral.to_array()
+    }
+
+    /// One query.
+    pub(crate) fn query(
+        &self,
+        cache: &Cache,
+        point: &LucentShadingPoint,
+    ) -> Result<LucentExitance, Failure> {
+        let point = ShadingPoint {
+            position: Vec3::from_array(point.position),
+            irradiance: Vec3::from_array(point.irradiance),
+        };
+        let m = cache
+            .0
+            .query(&self.profile, &point, self.local_integral, &self.settings)
+            .map_err(invalid)?;
+        Ok(LucentExitance {
+            total: m.total.to_array(),
+            local: m.local.to_array(),
+            global: m.global.to_array(),
+            local_irradiance: m.local_irradiance.to_array(),
+        })
+    }
+
+    /// Many queries, all or nothing: the first failure names its point.
+    pub(crate) fn query_many(
+        &self,
+        cache: &Cache,
+        points: &[LucentShadingPoint],
+    ) -> Result<Vec<LucentExitance>, Failure> {
+        points
+            .iter()
+            .enumerate()
+            .map(|(i, point)| {
+                self.query(cache, point)
+                    .map_err(|f| Failure::invalid(format!("point {i}: {}", f.message)))
+            })
+            .collect()
+    }
+}
+
+/// The core's method for a `LucentMethod` value.
+fn method(value: u32) -> Result<Method, Failure> {
+    Ok(match value {
+        v if v == LucentMethod::LUCENT_METHOD_HIERARCHICAL as u32 => Method::Hierarchical,
+        v if v == LucentMethod::LUCENT_METHOD_LOCAL_GLOBAL as u32 => Method::LocalGlobal,
+        v if v == LucentMethod::LUCENT_METHOD_EDGE_AWARE as u32 => Method::EdgeAware,
+        v if v == LucentMethod::LUCENT_METHOD_EXHAUSTIVE as u32 => Method::Exhaustive,
+        EDGE_REFINED => return Err(edge_refined_unsupported()),
+        v => {
+            return Err(Failure::invalid(format!(
+                "method {v} is not a LucentMethod (0 to 3)"
+            )));
+        }
+    })
+}
+
+fn edge_refined_unsupported() -> Failure {
+    Failure::new(
+        LucentStatus::LUCENT_UNSUPPORTED,
+        "the edge-refined method needs the caller's irradiance at quadrature points and is \
+         not offered through the C interface; use edge-aware",
+    )
+}
+
+/// The `LucentMethod` with this scene-format name (`hierarchical`, `local-global`,
+/// `edge-aware`, `exhaustive`).
+pub(crate) fn method_from_name(name: &str) -> Result<LucentMethod, Failure> {
+    let found = Method::ALL
+        .into_iter()
+        .find(|m| m.name() == name)
+        .ok_or_else(|| Failure::invalid(format!("unknown method \"{name}\"")))?;
+    Ok(match found {
+        Method::Hierarchical => LucentMethod::LUCENT_METHOD_HIERARCHICAL,
+        Method::LocalGlobal => LucentMethod::LUCENT_METHOD_LOCAL_GLOBAL,
+        Method::EdgeAware => LucentMethod::LUCENT_METHOD_EDGE_AWARE,
+        Method::Exhaustive => LucentMethod::LUCENT_METHOD_EXHAUSTIVE,
+        Method::EdgeRefined => return Err(edge_refined_unsupported()),
+    })
+}
+
+/// The core's defaults, for `lucent_query_options_init`.
+pub(crate) fn default_options() -> LucentQueryOptions {
+    let defaults = QuerySettings::default();
+    LucentQueryOptions {
+        method: LucentMethod::LUCENT_METHOD_EDGE_AWARE as u32,
+        smoothing_factor: 2.0,
+        epsilon: defaults.epsilon,
+        cull_tolerance: defaults.cull_tolerance,
+    }
+}
+
+/// The core's own `Sample` must stay the seven floats `LucentSample` mirrors.
+const _: () = assert!(size_of::<Sample>() == size_of::<LucentSample>());
