@@ -5,7 +5,8 @@
 
 use lucent_core::glam::Vec3;
 use lucent_core::{
-    IrradianceCache, LocalIntegralTable, Method, Profile, QuerySettings, Sample, ShadingPoint,
+    IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, QuerySettings, Sample,
+    ShadingPoint,
 };
 
 use crate::status::{Failure, LucentStatus};
@@ -32,7 +33,9 @@ pub(crate) struct Cache(IrradianceCache);
 pub(crate) struct Plan {
     profile: Profile,
     settings: QuerySettings,
-    local_integral: Vec3,
+    local: LocalTerm,
+    /// α for the unsplit methods too (the core's `LocalTerm::NONE` has α = 0).
+    smoothing_radius: f32,
 }
 
 fn invalid(error: impl std::fmt::Display) -> Failure {
@@ -157,32 +160,34 @@ impl Plan {
                     cache.mean_area()
                 )));
             }
-            Vec3::from_array(material.local_integral(alpha)?)
+            LocalIntegralTable::new(&material.0, alpha, alpha / 1024.0)
+                .map_err(invalid)?
+                .local_term(material.0.mean_free_path())
         } else {
-            Vec3::ZERO
+            LocalTerm::NONE
         };
         let settings = QuerySettings {
             method,
             epsilon: options.epsilon,
             cull_tolerance: options.cull_tolerance,
-            smoothing_radius: alpha,
         };
         settings.validate().map_err(invalid)?;
         Ok(Plan {
             profile: material.0,
             settings,
-            local_integral,
+            local: local_integral,
+            smoothing_radius: alpha,
         })
     }
 
     /// The smoothing radius α.
     pub(crate) fn smoothing_radius(&self) -> f32 {
-        self.settings.smoothing_radius
+        self.smoothing_radius
     }
 
     /// The local integral K per channel (zero for the methods without a local term).
     pub(crate) fn local_integral(&self) -> [f32; 3] {
-        self.local_integral.to_array()
+        self.local.k().to_array()
     }
 
     /// One query.
@@ -197,7 +202,7 @@ impl Plan {
         };
         let m = cache
             .0
-            .query(&self.profile, &point, self.local_integral, &self.settings)
+            .query(&self.profile, &point, self.local, &self.settings)
             .map_err(invalid)?;
         Ok(LucentExitance {
             total: m.total.to_array(),

@@ -3,8 +3,8 @@
 
 use lucent_core::glam::Vec3;
 use lucent_core::{
-    IrradianceCache, LocalIntegralTable, Method, Profile as CoreProfile, QuerySettings, Sample,
-    ShadingPoint,
+    IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile as CoreProfile, QuerySettings,
+    Sample, ShadingPoint,
 };
 use lucent_ffi::*;
 
@@ -92,14 +92,13 @@ fn the_c_interface_returns_what_the_core_computes() {
         let k = if core_method.is_split() {
             LocalIntegralTable::new(&profile, alpha, alpha / 1024.0)
                 .unwrap()
-                .lookup(profile.mean_free_path())
+                .local_term(profile.mean_free_path())
         } else {
-            Vec3::ZERO
+            LocalTerm::NONE
         };
-        assert_eq!(alpha_and_k(&q), (alpha, k.to_array()));
+        assert_eq!(alpha_and_k(&q), (alpha, k.k().to_array()));
         let core_settings = QuerySettings {
             method: core_method,
-            smoothing_radius: alpha,
             ..QuerySettings::default()
         };
         let o = options(method as u32, 1.5);
