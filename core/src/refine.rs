@@ -50,7 +50,13 @@
 //! radius 4α that touches the surface at x ([`LocalQuadrature::lift`]): on a concave surface
 //! whose radius of curvature is at least 4α they stay above it (on the tangent plane itself
 //! they would lie inside the surface, and its own triangles would shadow them), and on a
-//! convex one they lie somewhat above it. E(x′) is evaluated with the normal at x: to first
+//! convex one they lie somewhat above it. Their shadow rays ignore occluders within α/2 of the
+//! node ([`LocalQuadrature::shadow_skip`]), as if each node moved α/2 towards the light: that
+//! steps over the surface near x where it curves up more sharply than the lift (a crease, a
+//! fold, or the flat triangles under a node on the tangent plane of an interpolated normal),
+//! which would otherwise shadow the node and darken the local term, without moving where the
+//! ray meets anything farther away (the parallax of lifting the node as far). An occluder
+//! closer than α/2 to the surface is not seen by the nodes. E(x′) is evaluated with the normal at x: to first
 //! order in the disc's size the cosine's variation over the disc cancels by the kernel's
 //! radial symmetry, so only shadowing and second-order curvature terms are refined. Where the
 //! surface turns more sharply within α (an ear's rim, a thin fin), the nodes beyond the rim see
@@ -87,6 +93,9 @@ pub const EDGE_THRESHOLD: f32 = 0.5;
 const INTERVALS: usize = 32;
 /// The sphere the nodes are lifted onto has this radius in units of α.
 const LIFT_RADIUS: f32 = 4.0;
+/// The nodes' shadow rays ignore occluders within this many α of the node (module docs;
+/// 0.25, 0.5 and 1 measured on the bunny, `BENCHMARKS.md`).
+const SHADOW_SKIP: f32 = 0.5;
 
 /// The nodes and weights of the edge-refined local term for one profile and α.
 ///
@@ -187,6 +196,11 @@ impl LocalQuadrature {
         let r2 = self.offset[n % MAX_NODES].length_squared();
         let big = LIFT_RADIUS * self.alpha;
         r2 / (big + math::sqrt((big * big - r2).max(0.0)))
+    }
+
+    /// How far along each node's shadow rays occluders are ignored: α/2 (see the module docs).
+    pub fn shadow_skip(&self) -> f32 {
+        SHADOW_SKIP * self.alpha
     }
 
     /// Node n's weight per channel (the fractions sum to 1 in each channel).

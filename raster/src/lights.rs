@@ -33,6 +33,8 @@ pub struct Lighting<'a> {
     occluders: Option<&'a Bvh>,
     /// Scene size, for the shadow-ray offset.
     scale: f32,
+    /// How far along each shadow ray occluders are ignored (see [`Lighting::skipping`]).
+    skip: f32,
 }
 
 /// What one thread remembers between shadow rays: the last occluder of each of the first
@@ -60,7 +62,21 @@ impl<'a> Lighting<'a> {
             lights,
             occluders,
             scale,
+            skip: 0.0,
         }
+    }
+
+    /// The same lights with shadow rays that ignore occluders within `distance` of the point
+    /// (0, negative or not finite: none ignored): as if the point moved that far towards each
+    /// light, without moving where the ray meets anything farther away. The edge-refined
+    /// nodes use it to step over the crease of a concave surface they lie under.
+    pub fn skipping(self, distance: f32) -> Self {
+        let skip = if distance.is_finite() && distance > 0.0 {
+            distance
+        } else {
+            0.0
+        };
+        Lighting { skip, ..self }
     }
 
     /// Lights that [`Lighting::reach_mask`] reports on (later ones are ignored there).
@@ -83,7 +99,11 @@ impl<'a> Lighting<'a> {
             Some(bvh) => {
                 // Leave from the side the light is on.
                 let side = if n.dot(dir) >= 0.0 { n } else { -n };
-                !bvh.occluded_hinted(offset_origin(p, side, self.scale), dir, t_max, hint)
+                if t_max <= self.skip {
+                    return true;
+                }
+                let origin = offset_origin(p, side, self.scale) + dir * self.skip;
+                !bvh.occluded_hinted(origin, dir, t_max - self.skip, hint)
             }
         }
     }
@@ -370,6 +390,71 @@ mod tests {
         let l = Lighting::new(&lights, Some(&bvh), 2.0);
         assert_eq!(l.irradiance(Vec3::ZERO, Vec3::Z, 0), Vec3::ZERO);
         assert!(l.irradiance(Vec3::new(5.0, 0.0, 0.0), Vec3::Z, 0).x > 0.0);
+    }
+
+    /// `skipping(s)` ignores exactly the occluders nearer than s along the ray, for every kind
+    /// of light; beyond the light itself nothing can occlude.
+    #[test]
+    fn skipping_ignores_only_the_near_occluders() {
+        // A plate at height 1 over x < 1, and one at height 3 over x < 1.
+        let mut tris = plate(-5.0, 1.0, 1.0).to_vec();
+        tris.extend(plate(-5.0, 1.0, 3.0));
+        let bvh = Bvh::build(&tris);
+        let near_only = Bvh::build(&plate(-5.0, 1.0, 1.0));
+        let sphere = Light::Sphere {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            radius: 0.2,
+            color: Vec3::ONE,
+            intensity: 25.0,
+            samples: 4,
+        };
+        let directional = Light::Directional {
+            direction: -Vec3::Z,
+            color: Vec3::ONE,
+            irradiance: 1.0,
+        };
+        for light in [
+            point_light(Vec3::new(0.0, 0.0, 5.0), 25.0),
+            sphere,
+            directional,
+        ] {
+            let lights = [light];
+            let open = Lighting::new(&lights, None, 5.0).irradiance(Vec3::ZERO, Vec3::Z, 3);
+            assert!(open.x > 0.5, "{:?}: {open}", lights[0]);
+            let l = Lighting::new(&lights, Some(&bvh), 5.0);
+            assert_eq!(l.irradiance(Vec3::ZERO, Vec3::Z, 3), Vec3::ZERO);
+            // Stepping over the plate at height 1 still meets the one at height 3.
+            assert_eq!(
+                l.skipping(1.5).irradiance(Vec3::ZERO, Vec3::Z, 3),
+                Vec3::ZERO
+            );
+            assert_eq!(
+                l.skipping(0.9).irradiance(Vec3::ZERO, Vec3::Z, 3),
+                Vec3::ZERO
+            );
+            // Without the far plate, skipping 1.5 sees the light as if nothing occluded.
+            let near = Lighting::new(&lights, Some(&near_only), 5.0);
+            assert_eq!(
+                near.skipping(0.9).irradiance(Vec3::ZERO, Vec3::Z, 3),
+                Vec3::ZERO
+            );
+            assert_eq!(near.skipping(1.5).irradiance(Vec3::ZERO, Vec3::Z, 3), open);
+            // Nonsense distances skip nothing.
+            for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+                assert_eq!(
+                    near.skipping(bad).irradiance(Vec3::ZERO, Vec3::Z, 3),
+                    Vec3::ZERO
+                );
+            }
+        }
+        // A point light nearer than the skip is visible whatever lies between.
+        let lights = [point_light(Vec3::new(0.0, 0.0, 2.0), 4.0)];
+        let l = Lighting::new(&lights, Some(&near_only), 5.0);
+        assert_eq!(l.irradiance(Vec3::ZERO, Vec3::Z, 0), Vec3::ZERO);
+        assert_eq!(
+            l.skipping(2.5).irradiance(Vec3::ZERO, Vec3::Z, 0),
+            Vec3::ONE
+        );
     }
 
     #[test]
