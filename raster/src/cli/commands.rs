@@ -5,7 +5,10 @@ use std::path::Path;
 
 use lucent_core::{Profile, presets};
 
-use super::{BakeArgs, BenchArgs, MethodArg, RenderArgs, SamplesArg};
+#[cfg(feature = "harness")]
+use super::BenchArgs;
+use super::{BakeArgs, MethodArg, RenderArgs, SamplesArg};
+#[cfg(feature = "harness")]
 use crate::bench::{self, BenchConfig, BenchScene};
 use crate::output::{write_exr, write_png};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
@@ -333,6 +336,7 @@ pub fn presets() -> Result<(), String> {
 }
 
 /// `lucent bench`.
+#[cfg(feature = "harness")]
 pub fn bench(args: &BenchArgs) -> Result<(), String> {
     let mut config = if args.quick {
         BenchConfig::quick()

@@ -20,6 +20,11 @@ pub enum OutputError {
         /// The underlying error.
         source: io::Error,
     },
+    /// The output file exists and is read-only: lucent does not replace it.
+    ReadOnly {
+        /// The file.
+        path: PathBuf,
+    },
     /// The data handed to a writer (or decoded by a reader) does not describe a valid image or
     /// sample set, e.g. a pixel buffer of the wrong length or an invalid layer name.
     Invalid {
@@ -140,6 +145,12 @@ impl fmt::Display for OutputError {
             } => {
                 write!(f, "{}: {action}: {source}", path.display())
             }
+            OutputError::ReadOnly { path } => write!(
+                f,
+                "{}: the file is read-only; lucent does not replace it (make it writable or \
+                 write elsewhere)",
+                path.display()
+            ),
             OutputError::Invalid { path, message } => {
                 if path.as_os_str().is_empty() {
                     write!(f, "{message}")
