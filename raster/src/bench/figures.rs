@@ -1,5 +1,6 @@
 //! The benchmark's pictures: per scene an error-against-time chart (overall and in the
-//! shadow-edge band) and a contact sheet laid out like Figure 1 of Neulander 2010.
+//! shadow-edge band, SVG) and a contact sheet laid out like Figure 1 of Neulander 2010 (PNG;
+//! its caption, the row and column names below, goes into `report.md`).
 //!
 //! ```text
 //!               no smoothing   LM07   edge-aware   edge-refined   ground truth
@@ -8,6 +9,9 @@
 //! error            ▢            ▢         ▢            ▢                   (relative, log
 //! error ×3         ▢            ▢         ▢            ▢                    scale, one white)
 //! ```
+//!
+//! The charts can be drawn again from a report's `results.csv` ([`replot`]) without running
+//! anything.
 
 use std::path::Path;
 
@@ -15,8 +19,10 @@ use super::runner::{MethodSetting, Reference};
 use super::{BenchConfig, BenchError, BenchReport, BenchScene};
 use crate::output::heatmap::max_pixel_error;
 use crate::output::png::encode_srgb8;
-use crate::output::{ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, error_heatmap};
-use crate::plot::{Chart, Series, Sheet, SheetRow, Tile, crop_magnify, render_chart, render_sheet};
+use crate::output::{
+    ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, error_heatmap, write_text_atomically,
+};
+use crate::plot::{Chart, Series, Sheet, Tile, crop_magnify, render_chart, render_sheet};
 use crate::scene::SssMethod;
 
 /// Magnification of the shadow-edge insets.
@@ -25,8 +31,164 @@ const INSET_ZOOM: u32 = 3;
 /// Inset marker colour.
 const MARKER: [u8; 3] = [255, 220, 0];
 
-/// Writes `<scene>-error-vs-time.png`, `<scene>-edge-error-vs-time.png` and, when the sheet's
-/// images are all there, `<scene>-figure1.png`.
+/// One run as a chart point: its series label, render time, and errors.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChartPoint {
+    /// The series (a method setting's label).
+    pub label: String,
+    /// Render time in seconds.
+    pub time: f64,
+    /// Mean relative error over the translucent pixels.
+    pub error: f64,
+    /// Mean relative error in the shadow-edge band, if the scene has one.
+    pub edge_error: Option<f64>,
+}
+
+/// The chart files of a scene, without the directory: `<scene>-error-vs-time.svg` and
+/// `<scene>-edge-error-vs-time.svg`.
+pub fn chart_files(scene: &str) -> [String; 2] {
+    [
+        format!("{scene}-error-vs-time.svg"),
+        format!("{scene}-edge-error-vs-time.svg"),
+    ]
+}
+
+/// Width and height of the charts.
+const CHART_SIZE: (u32, u32) = (800, 560);
+
+/// Writes a scene's two error-against-time charts ([`chart_files`]) into `out`: one series
+/// per label, in the order the labels first appear in `points`.
+pub fn write_charts(scene: &str, points: &[ChartPoint], out: &Path) -> Result<(), BenchError> {
+    let mut labels: Vec<&str> = Vec::new();
+    for p in points {
+        if !labels.contains(&p.label.as_str()) {
+            labels.push(&p.label);
+        }
+    }
+    for (edge, file, what) in [
+        (false, &chart_files(scene)[0], "translucent pixels"),
+        (true, &chart_files(scene)[1], "shadow-edge band"),
+    ] {
+        let series = labels
+            .iter()
+            .map(|&label| Series {
+                label: label.to_string(),
+                points: points
+                    .iter()
+                    .filter(|p| p.label == label)
+                    .filter_map(|p| Some((p.time, if edge { p.edge_error? } else { p.error })))
+                    .collect(),
+            })
+            .collect();
+        let chart = Chart {
+            title: format!("{scene}: error against time ({what})"),
+            x_label: "render time (s)".to_string(),
+            y_label: "mean relative error".to_string(),
+            series,
+            log_x: true,
+            log_y: true,
+        };
+        let svg = render_chart(&chart, CHART_SIZE.0, CHART_SIZE.1)?;
+        write_text_atomically(&out.join(file), &svg)?;
+    }
+    Ok(())
+}
+
+/// Draws the error-against-time charts again from `dir/results.csv` (as [`write_report`]
+/// wrote it) into `dir`, for every scene in it; returns the files written. Only the runs at
+/// each scene's own smoothing factor (its first row's) are drawn, like the charts of the run
+/// itself; the smoothing sweep's other rows are left out.
+///
+/// [`write_report`]: super::write_csv
+pub fn replot(dir: &Path) -> Result<Vec<std::path::PathBuf>, BenchError> {
+    let path = dir.join("results.csv");
+    let text = std::fs::read_to_string(&path).map_err(|e| BenchError::Read {
+        path: path.clone(),
+        source: e,
+    })?;
+    let bad = |line: usize, message: String| BenchError::Csv {
+        path: path.clone(),
+        line,
+        message,
+    };
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| bad(1, format!("no column '{name}'")))
+    };
+    let [scene, method, epsilon, smoothing, total, error, edge] = [
+        "scene",
+        "method",
+        "epsilon",
+        "smoothing",
+        "total_s",
+        "error_mean_rel",
+        "edge_mean_rel",
+    ]
+    .map(column);
+    let (scene, method, epsilon, smoothing, total, error, edge) =
+        (scene?, method?, epsilon?, smoothing?, total?, error?, edge?);
+    // Per scene, in the order of the file: its own smoothing factor and its points.
+    let mut scenes: Vec<(String, String, Vec<ChartPoint>)> = Vec::new();
+    for (index, line) in lines.enumerate().filter(|(_, l)| !l.is_empty()) {
+        let number = index + 2;
+        let cells: Vec<&str> = line.split(',').collect();
+        if cells.len() != header.len() {
+            return Err(bad(
+                number,
+                format!("{} cells, the header has {}", cells.len(), header.len()),
+            ));
+        }
+        let number_at = |c: usize| -> Result<f64, BenchError> {
+            cells[c]
+                .parse::<f64>()
+                .map_err(|_| bad(number, format!("'{}' is not a number", cells[c])))
+        };
+        let label = if cells[method] == "hierarchical" {
+            format!("hierarchical eps={}", cells[epsilon])
+        } else {
+            cells[method].to_string()
+        };
+        let point = ChartPoint {
+            label,
+            time: number_at(total)?,
+            error: number_at(error)?,
+            edge_error: if cells[edge].is_empty() {
+                None
+            } else {
+                Some(number_at(edge)?)
+            },
+        };
+        let name = cells[scene];
+        if !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+            || name.is_empty()
+        {
+            return Err(bad(number, format!("'{name}' is not a scene name")));
+        }
+        match scenes.iter_mut().find(|(s, _, _)| s == name) {
+            Some((_, k, points)) => {
+                if *k == cells[smoothing] {
+                    points.push(point);
+                }
+            }
+            None => scenes.push((name.to_string(), cells[smoothing].to_string(), vec![point])),
+        }
+    }
+    let mut written = Vec::new();
+    for (name, _, points) in &scenes {
+        write_charts(name, points, dir)?;
+        written.extend(chart_files(name).iter().map(|f| dir.join(f)));
+    }
+    Ok(written)
+}
+
+/// Writes a scene's charts ([`write_charts`]) and, when the sheet's images are all there,
+/// `<scene>-figure1.png`; returns the contact sheet's caption (Markdown) for the report.
 pub fn write_scene_figures(
     config: &BenchConfig,
     scene: BenchScene,
@@ -35,42 +197,24 @@ pub fn write_scene_figures(
     sheet_images: &[(MethodSetting, RgbImage)],
     exposure: f32,
     out: &Path,
-) -> Result<(), BenchError> {
-    for (edge, file, what) in [
-        (false, "error-vs-time", "translucent pixels"),
-        (true, "edge-error-vs-time", "shadow-edge band"),
-    ] {
-        let series = config
-            .settings()
-            .into_iter()
-            .map(|setting| Series {
-                label: setting.label(),
-                points: report
-                    .runs
-                    .iter()
-                    .filter(|r| r.scene == scene && r.setting == setting)
-                    .filter_map(|r| {
-                        let e = if edge {
-                            r.edge_error?.mean_relative_l1
-                        } else {
-                            r.error.mean_relative_l1
-                        };
-                        Some((r.timings.total.as_secs_f64(), e))
-                    })
-                    .collect(),
-            })
-            .collect();
-        let chart = Chart {
-            title: format!("{}: error against time ({what})", scene.name()),
-            x_label: "render time (s)".to_string(),
-            y_label: "mean relative error".to_string(),
-            series,
-            log_x: true,
-            log_y: true,
-        };
-        render_chart(&chart, 800, 560)?
-            .write_png(&out.join(format!("{}-{file}.png", scene.name())))?;
-    }
+) -> Result<Option<String>, BenchError> {
+    let points: Vec<ChartPoint> = config
+        .settings()
+        .into_iter()
+        .flat_map(|setting| {
+            report
+                .runs
+                .iter()
+                .filter(move |r| r.scene == scene && r.setting == setting)
+                .map(move |r| ChartPoint {
+                    label: setting.label(),
+                    time: r.timings.total.as_secs_f64(),
+                    error: r.error.mean_relative_l1,
+                    edge_error: r.edge_error.map(|e| e.mean_relative_l1),
+                })
+        })
+        .collect();
+    write_charts(scene.name(), &points, out)?;
 
     let pick = |method: SssMethod| {
         sheet_images
@@ -88,11 +232,11 @@ pub fn write_scene_figures(
         pick(SssMethod::EdgeAware),
         pick(SssMethod::EdgeRefined),
     ) else {
-        return Ok(());
+        return Ok(None);
     };
-    let sheet = figure1(config, reference, [hier, lm, n10, refined], exposure)?;
+    let (sheet, caption) = figure1(config, reference, [hier, lm, n10, refined], exposure)?;
     render_sheet(&sheet)?.write_png(&out.join(format!("{}-figure1.png", scene.name())))?;
-    Ok(())
+    Ok(Some(caption))
 }
 
 /// The inset square: centred on the shadow-edge pixel nearest the band's centroid.
@@ -164,7 +308,7 @@ fn figure1(
     reference: &Reference,
     tests: [&RgbImage; 4],
     exposure: f32,
-) -> Result<Sheet, BenchError> {
+) -> Result<(Sheet, String), BenchError> {
     let (w, h) = reference.image.size();
     let rect = inset_rect(reference);
     // One white level for all four error maps: the largest per-pixel relative error.
@@ -206,40 +350,21 @@ fn figure1(
     error_maps.push(None);
     error_insets.push(None);
 
-    Ok(Sheet {
-        title: format!(
-            "{} samples, {}x{}: relative error, log scale over 3 decades, white = {:.1}%",
-            config.sheet_count,
-            w,
-            h,
-            white * 100.0
-        ),
-        column_labels: vec![
-            format!("no smoothing (JB02, eps {})", config.split_epsilon),
-            "LM07 (local-global)".to_string(),
-            "edge-aware (N10)".to_string(),
-            "edge-refined".to_string(),
-            "ground truth".to_string(),
-        ],
-        rows: vec![
-            SheetRow {
-                label: "image".to_string(),
-                tiles: images,
-            },
-            SheetRow {
-                label: format!("shadow edge x{INSET_ZOOM}"),
-                tiles: insets,
-            },
-            SheetRow {
-                label: "error".to_string(),
-                tiles: error_maps,
-            },
-            SheetRow {
-                label: format!("error x{INSET_ZOOM}"),
-                tiles: error_insets,
-            },
-        ],
-    })
+    let caption = format!(
+        "Columns: no smoothing (JB02, ε {}) · LM07 (local-global) · edge-aware (N10) · \
+         edge-refined · ground truth. Rows: image (the inset square in yellow) · shadow edge \
+         ×{INSET_ZOOM} · relative error · relative error ×{INSET_ZOOM}. {} samples, {}×{}; \
+         error on a log scale over 3 decades, white = {:.1}%.",
+        config.split_epsilon,
+        config.sheet_count,
+        w,
+        h,
+        white * 100.0
+    );
+    let sheet = Sheet {
+        rows: vec![images, insets, error_maps, error_insets],
+    };
+    Ok((sheet, caption))
 }
 
 #[cfg(test)]

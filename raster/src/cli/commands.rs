@@ -338,6 +338,15 @@ pub fn presets() -> Result<(), String> {
 /// `lucent bench`.
 #[cfg(feature = "harness")]
 pub fn bench(args: &BenchArgs) -> Result<(), String> {
+    if args.replot {
+        let files = bench::replot(&args.output).map_err(|e| format!("bench: {e}"))?;
+        if !args.quiet {
+            for file in files {
+                eprintln!("{}", file.display());
+            }
+        }
+        return Ok(());
+    }
     let mut config = if args.quick {
         BenchConfig::quick()
     } else {

@@ -182,9 +182,13 @@ pub struct BakeArgs {
 #[cfg(feature = "harness")]
 #[derive(Debug, Args, Clone)]
 pub struct BenchArgs {
-    /// Where to write the report (report.md, results.csv, PNG plots and sheets).
+    /// Where to write the report (report.md, results.csv, SVG charts, PNG contact sheets).
     #[arg(short, long, value_name = "DIR", default_value = "bench-report")]
     pub output: PathBuf,
+    /// Run nothing: draw the error-against-time charts again from the results.csv in the
+    /// output folder (written by an earlier run).
+    #[arg(long)]
+    pub replot: bool,
     /// A small version (96², two sample counts) that finishes in well under a minute.
     #[arg(long)]
     pub quick: bool,

@@ -94,16 +94,23 @@ where
     Ok(())
 }
 
+/// Writes the text `text` to `path` atomically (see [`write_atomically`]): reports, CSV
+/// tables, SVG charts.
+pub fn write_text_atomically(path: &Path, text: &str) -> Result<(), OutputError> {
+    write_atomically(path, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|e| OutputError::io(path, "writing the file failed", e))
+    })
+}
+
 /// Fails with [`OutputError::ReadOnly`] when `path` exists and its permissions are
 /// read-only. The permission bits are checked, not a write attempted: the superuser may
 /// write any file, and the rename would replace it anyway.
 fn refuse_read_only(path: &Path) -> Result<(), OutputError> {
     match std::fs::metadata(path) {
-        Ok(meta) if meta.is_file() && meta.permissions().readonly() => {
-            Err(OutputError::ReadOnly {
-                path: path.to_path_buf(),
-            })
-        }
+        Ok(meta) if meta.is_file() && meta.permissions().readonly() => Err(OutputError::ReadOnly {
+            path: path.to_path_buf(),
+        }),
         // A missing target is the usual case; any other problem with it (a directory, no
         // access) surfaces with its own message when the rename fails.
         _ => Ok(()),
@@ -279,7 +286,8 @@ pub(crate) mod tests {
         permissions.set_readonly(false);
         fs::set_permissions(&target, permissions).unwrap();
         write_atomically(&target, |w| {
-            w.write_all(b"new").map_err(|e| OutputError::io(&target, "write", e))
+            w.write_all(b"new")
+                .map_err(|e| OutputError::io(&target, "write", e))
         })
         .unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"new");
