@@ -801,7 +801,69 @@ fn end_to_end(out: &Path, threads: Option<usize>) -> Result<Duration, BenchError
 
 #[cfg(test)]
 mod tests {
+    use std::error::Error as _;
+
     use super::*;
+
+    #[test]
+    fn errors_keep_their_source_and_message() {
+        let dir = Path::new("/nonexistent/lucent-bench");
+        let e = replot(dir).unwrap_err();
+        assert!(matches!(e, BenchError::Read { .. }), "{e:?}");
+        assert!(e.to_string().contains("results.csv"), "{e}");
+        let io = e.source().and_then(|s| s.downcast_ref::<std::io::Error>());
+        assert_eq!(io.map(|e| e.kind()), Some(std::io::ErrorKind::NotFound));
+
+        let render = RenderError::Limit("too many triangles".into());
+        let e = BenchError::from(render);
+        assert_eq!(e.to_string(), "too many triangles");
+        assert!(
+            e.source()
+                .and_then(|s| s.downcast_ref::<RenderError>())
+                .is_some()
+        );
+        assert!(BenchError::new("bad").source().is_none());
+    }
+
+    #[test]
+    fn replot_rejects_a_malformed_table_by_line() {
+        let dir = std::env::temp_dir().join(format!("lucent-replot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let header = "scene,method,epsilon,smoothing,total_s,error_mean_rel,edge_mean_rel";
+        for (body, needle) in [
+            ("scene,method\n", "no column 'epsilon'"),
+            (
+                &*format!("{header}\nsphere,edge-aware,0.5,1.5,x,0.1,\n"),
+                "line 2: 'x' is not a number",
+            ),
+            (
+                &*format!("{header}\nsphere,edge-aware,0.5\n"),
+                "line 2: 3 cells",
+            ),
+            (
+                &*format!("{header}\n../x,edge-aware,0.5,1.5,1,0.1,\n"),
+                "not a scene name",
+            ),
+        ] {
+            std::fs::write(dir.join("results.csv"), body).unwrap();
+            let e = replot(&dir).unwrap_err().to_string();
+            assert!(e.contains(needle), "{e}");
+        }
+        // A good table: one series per method, the sweep's other k left out.
+        let rows = format!(
+            "{header}\nsphere,hierarchical,0.5,1.5,1,0.2,0.3\nsphere,edge-aware,0.5,1.5,2,0.1,\n\
+             sphere,edge-aware,0.5,3,4,0.05,\n"
+        );
+        std::fs::write(dir.join("results.csv"), rows).unwrap();
+        let files = replot(&dir).unwrap();
+        assert_eq!(files.len(), 2);
+        let svg = std::fs::read_to_string(&files[0]).unwrap();
+        assert!(svg.contains("data-label=\"hierarchical eps=0.5\""), "{svg}");
+        assert!(svg.contains("data-label=\"edge-aware\""), "{svg}");
+        // Two markers and the legend's two swatches: the row at k = 3 is not drawn.
+        assert_eq!(svg.matches("<circle cx").count(), 4, "{svg}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn presets_are_valid_and_their_sheet_count_is_run() {

@@ -25,7 +25,7 @@ use super::edge_refined::{self, RefinePoint};
 use super::prepare::Prepared;
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
-use crate::material::{LocalTerm, Shader, TranslucentShader};
+use crate::material::{LocalTerm, MaterialError, Shader, TranslucentShader};
 use crate::raster::{Fragment, VisibilityBuffer};
 use crate::sampling::rng::splitmix64;
 
@@ -59,7 +59,10 @@ impl ObjectCache {
         let (uniform_k, quadrature) = match (&local, shader) {
             (Some(term), Some(shader)) if !shader.is_textured() => {
                 let point = shader.at(Vec2::ZERO).map_err(|e| {
-                    RenderError::Material(format!("material '{}': {e}", shader.name))
+                    RenderError::Material(MaterialError::Params {
+                        material: shader.name.clone(),
+                        source: e,
+                    })
                 })?;
                 (
                     Some(term.exact(&point)),
@@ -287,7 +290,10 @@ impl Shading<'_> {
                     RenderError::Core(format!("no irradiance cache for object {object}"))
                 })?;
                 let point = shader.at(uv).map_err(|e| {
-                    RenderError::Material(format!("material '{}': {e}", shader.name))
+                    RenderError::Material(MaterialError::Params {
+                        material: shader.name.clone(),
+                        source: e,
+                    })
                 })?;
                 let method = self.settings.method;
                 let mut e = Vec3::ZERO;
@@ -332,7 +338,7 @@ impl Shading<'_> {
                         &settings,
                         stats,
                     )
-                    .map_err(|err| RenderError::Core(format!("query at {position}: {err}")))?;
+                    .map_err(|source| RenderError::Query { position, source })?;
                 let m = if m.refine {
                     let q = oc
                         .quadrature
