@@ -105,8 +105,9 @@ pub fn write_text_atomically(path: &Path, text: &str) -> Result<(), OutputError>
 
 /// Fails with [`OutputError::ReadOnly`] when `path` exists and its permissions are
 /// read-only. The permission bits are checked, not a write attempted: the superuser may
-/// write any file, and the rename would replace it anyway.
-fn refuse_read_only(path: &Path) -> Result<(), OutputError> {
+/// write any file, and the rename would replace it anyway. [`write_atomically`] checks this
+/// first; a command that writes several files checks them all before writing any.
+pub fn refuse_read_only(path: &Path) -> Result<(), OutputError> {
     match std::fs::metadata(path) {
         Ok(meta) if meta.is_file() && meta.permissions().readonly() => Err(OutputError::ReadOnly {
             path: path.to_path_buf(),

@@ -36,7 +36,7 @@ pub mod png;
 pub mod regions;
 pub mod srgb;
 
-pub use atomic::{WriteSeek, write_atomically, write_text_atomically};
+pub use atomic::{WriteSeek, refuse_read_only, write_atomically, write_text_atomically};
 #[cfg(feature = "harness")]
 pub use compare::{ErrorStats, RELATIVE_L1_OFFSET, compare};
 pub use error::OutputError;
