@@ -94,12 +94,12 @@ pub fn write_charts(scene: &str, points: &[ChartPoint], out: &Path) -> Result<()
     Ok(())
 }
 
-/// Draws the error-against-time charts again from `dir/results.csv` (as [`write_report`]
+/// Draws the error-against-time charts again from `dir/results.csv` (as [`write_csv`]
 /// wrote it) into `dir`, for every scene in it; returns the files written. Only the runs at
 /// each scene's own smoothing factor (its first row's) are drawn, like the charts of the run
 /// itself; the smoothing sweep's other rows are left out.
 ///
-/// [`write_report`]: super::write_csv
+/// [`write_csv`]: super::write_csv
 pub fn replot(dir: &Path) -> Result<Vec<std::path::PathBuf>, BenchError> {
     let path = dir.join("results.csv");
     let text = std::fs::read_to_string(&path).map_err(|e| BenchError::Read {
