@@ -31,6 +31,7 @@
 //! sphere: hierarchical at ε = 0.05 is within 2e-5 of the exhaustive sum on the same
 //! samples.
 
+mod charts;
 mod figures;
 mod overhead;
 mod report;
@@ -42,7 +43,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-pub use figures::{ChartPoint, chart_files, replot, write_charts};
+pub use charts::{ChartPoint, chart_files, replot, write_charts};
 pub use overhead::{OverheadRow, Spread};
 pub use report::{write_csv, write_markdown, write_overhead_csv};
 pub use runner::{MethodSetting, Reference, RunResult};

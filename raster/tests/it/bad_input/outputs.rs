@@ -108,6 +108,7 @@ fn unwritable_bake_output() {
 
 /// `compare` on missing, truncated and non-image files, and of different sizes: an error
 /// naming the file, and no heat map written.
+#[cfg(feature = "harness")]
 #[test]
 fn compare_bad_images() {
     let sb = Sandbox::new("out-compare");
