@@ -12,10 +12,15 @@
 //! | lights and irradiance | [`lights`] |
 //! | shading through the core | [`material`], [`render`] |
 //! | PNG / EXR / PLY output, image comparison | [`output`] |
-//! | 2-D report drawing: charts, contact sheets | [`plot`] |
-//! | run time against error: `lucent bench` | [`bench`](mod@bench) |
+//! | 2-D report drawing: charts, contact sheets | `plot` (feature `harness`) |
+//! | run time against error: `lucent bench` | `bench` (feature `harness`) |
 //! | the `lucent` command | [`cli`] |
+//!
+//! The feature `harness` (on by default) adds the experiment harness: `bench`, `plot`, the
+//! image comparison in [`output`] and the `bench` and `compare` commands. Without it
+//! (`--no-default-features`) the crate is the renderer alone, without `tiny-skia`.
 
+#[cfg(feature = "harness")]
 pub mod bench;
 pub mod camera;
 pub mod cli;
@@ -23,6 +28,7 @@ pub mod geometry;
 pub mod lights;
 pub mod material;
 pub mod output;
+#[cfg(feature = "harness")]
 pub mod plot;
 pub mod raster;
 pub mod render;

@@ -7,6 +7,7 @@
 //! K_d also varies α′; K then comes from the core's [`LocalIntegralByKd`], tables at evenly
 //! spaced K_d interpolated linearly in K_d per channel.
 
+use std::fmt;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
@@ -18,6 +19,57 @@ use lucent_core::{
 
 use crate::scene::{ColorParam, Distance, Material, Medium, ScalarParam, Specular};
 use crate::texture::Texture;
+
+/// Why a material cannot be shaded.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum MaterialError {
+    /// The material names a preset that does not exist.
+    UnknownPreset {
+        /// The material's name.
+        material: String,
+        /// The preset it names.
+        preset: String,
+    },
+    /// The core rejected the material's parameters (at a surface point, for a textured one).
+    Params {
+        /// The material's name.
+        material: String,
+        /// What the core found wrong.
+        source: ParamError,
+    },
+}
+
+impl MaterialError {
+    fn params(material: &str, source: ParamError) -> Self {
+        MaterialError::Params {
+            material: material.to_string(),
+            source,
+        }
+    }
+}
+
+impl fmt::Display for MaterialError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MaterialError::UnknownPreset { material, preset } => {
+                write!(f, "material '{material}': unknown preset '{preset}'")
+            }
+            MaterialError::Params { material, source } => {
+                write!(f, "material '{material}': {source}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for MaterialError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            MaterialError::UnknownPreset { .. } => None,
+            MaterialError::Params { source, .. } => Some(source),
+        }
+    }
+}
 
 /// A material ready for shading.
 #[derive(Debug)]
@@ -33,16 +85,18 @@ pub enum Shader {
 
 impl Shader {
     /// Resolves a scene material (validating its parameters).
-    pub fn new(material: &Material) -> Result<Shader, String> {
+    pub fn new(material: &Material) -> Result<Shader, MaterialError> {
         match material {
             Material::Lambert { albedo, .. } => Ok(Shader::Lambert { albedo: *albedo }),
             Material::Translucent(t) => {
-                let err = |e: ParamError| format!("material '{}': {e}", t.name);
+                let err = |e: ParamError| MaterialError::params(&t.name, e);
                 let params = match &t.medium {
                     Medium::Preset { name, mm_per_unit } => {
-                        let preset = presets::find(name).ok_or_else(|| {
-                            format!("material '{}': unknown preset '{name}'", t.name)
-                        })?;
+                        let preset =
+                            presets::find(name).ok_or_else(|| MaterialError::UnknownPreset {
+                                material: t.name.clone(),
+                                preset: name.clone(),
+                            })?;
                         Params::Fixed(Profile::from_preset(preset, *mm_per_unit).map_err(err)?)
                     }
                     Medium::Coefficients {
@@ -472,7 +526,14 @@ mod tests {
             specular: None,
         });
         let err = Shader::new(&m).unwrap_err();
-        assert!(err.contains("wax") && err.contains("sigma_a"), "{err}");
+        let message = err.to_string();
+        assert!(
+            message.contains("wax") && message.contains("sigma_a"),
+            "{err}"
+        );
+        // The core's error is kept as the source.
+        let source = std::error::Error::source(&err).expect("a source");
+        assert!(source.downcast_ref::<ParamError>().is_some(), "{source:?}");
         let m = Material::Translucent(TranslucentMaterial {
             name: "stone".into(),
             medium: Medium::Preset {
@@ -481,6 +542,10 @@ mod tests {
             },
             specular: None,
         });
-        assert!(Shader::new(&m).unwrap_err().contains("granite"));
+        let err = Shader::new(&m).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "material 'stone': unknown preset 'granite'"
+        );
     }
 }

@@ -51,8 +51,20 @@ pub enum TextureEncoding {
 pub struct TextureError {
     /// The file concerned.
     pub path: PathBuf,
-    /// What went wrong.
+    /// What went wrong (it includes the source's message, if there is a source).
     pub message: String,
+    /// The error behind it, if one: returned by [`source`](std::error::Error::source).
+    pub source: Option<TextureSource>,
+}
+
+/// The error behind a [`TextureError`].
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum TextureSource {
+    /// Reading the file failed.
+    Io(std::io::Error),
+    /// The PNG decoder failed.
+    Png(png::DecodingError),
 }
 
 impl fmt::Display for TextureError {
@@ -61,7 +73,15 @@ impl fmt::Display for TextureError {
     }
 }
 
-impl std::error::Error for TextureError {}
+impl std::error::Error for TextureError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.source {
+            Some(TextureSource::Io(e)) => Some(e),
+            Some(TextureSource::Png(e)) => Some(e),
+            None => None,
+        }
+    }
+}
 
 impl Texture {
     /// Bilinear lookup with repeat wrapping. `uv = (0, 0)` is the bottom-left corner of the
@@ -93,6 +113,12 @@ impl Texture {
         let fail = |message: String| TextureError {
             path: path.to_path_buf(),
             message,
+            source: None,
+        };
+        let decoding = |what: &str, e: png::DecodingError| TextureError {
+            path: path.to_path_buf(),
+            message: format!("{what}: {e}"),
+            source: Some(TextureSource::Png(e)),
         };
         let mut decoder = png::Decoder::new(Cursor::new(bytes));
         decoder.set_transformations(png::Transformations::EXPAND);
@@ -100,7 +126,7 @@ impl Texture {
         let (width, height) = {
             let info = decoder
                 .read_header_info()
-                .map_err(|e| fail(format!("not a readable PNG: {e}")))?;
+                .map_err(|e| decoding("not a readable PNG", e))?;
             (info.width, info.height)
         };
         check_size(width, height).map_err(fail)?;
@@ -110,14 +136,14 @@ impl Texture {
         });
         let mut reader = decoder
             .read_info()
-            .map_err(|e| fail(format!("malformed PNG: {e}")))?;
+            .map_err(|e| decoding("malformed PNG", e))?;
         let size = reader
             .output_buffer_size()
             .ok_or_else(|| fail("image too large for memory".to_string()))?;
         let mut buf = vec![0u8; size];
         let frame = reader
             .next_frame(&mut buf)
-            .map_err(|e| fail(format!("malformed or truncated PNG data: {e}")))?;
+            .map_err(|e| decoding("malformed or truncated PNG data", e))?;
         let channels = match frame.color_type {
             png::ColorType::Grayscale => 1,
             png::ColorType::GrayscaleAlpha => 2,
@@ -150,6 +176,7 @@ impl Texture {
         let bytes = std::fs::read(path).map_err(|e| TextureError {
             path: path.to_path_buf(),
             message: format!("cannot read: {e}"),
+            source: Some(TextureSource::Io(e)),
         })?;
         Texture::from_png_bytes(&bytes, path, encoding)
     }
@@ -437,6 +464,8 @@ pub(crate) mod tests {
         let err = Texture::from_png_bytes(b"not a png", Path::new("x.png"), TextureEncoding::Srgb)
             .expect_err("garbage");
         assert!(err.to_string().contains("x.png"), "{err}");
+        let source = std::error::Error::source(&err).expect("the decoder's error");
+        assert!(source.downcast_ref::<png::DecodingError>().is_some());
         let data: Vec<u8> = (0..64 * 64 * 3).map(|i| (i * 7 % 251) as u8).collect();
         let png = encode_png(
             64,
@@ -477,6 +506,10 @@ pub(crate) mod tests {
         let err = Texture::from_png_bytes(&huge, Path::new("h.png"), TextureEncoding::Srgb)
             .expect_err("too many texels");
         assert!(err.message.contains("texels"), "{err}");
+        assert!(
+            std::error::Error::source(&err).is_none(),
+            "a check, not a decoder error"
+        );
     }
 
     #[test]
@@ -485,6 +518,11 @@ pub(crate) mod tests {
             .expect_err("missing");
         assert!(err.to_string().contains("/nonexistent/kd.png"), "{err}");
         assert!(err.message.contains("cannot read"), "{err}");
+        let source = std::error::Error::source(&err).expect("the I/O error");
+        let io = source
+            .downcast_ref::<std::io::Error>()
+            .expect("an io::Error");
+        assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
     }
 
     /// Rewrites the IHDR width/height of a PNG and fixes its CRC.

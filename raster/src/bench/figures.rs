@@ -1,5 +1,6 @@
 //! The benchmark's pictures: per scene an error-against-time chart (overall and in the
-//! shadow-edge band) and a contact sheet laid out like Figure 1 of Neulander 2010.
+//! shadow-edge band, SVG) and a contact sheet laid out like Figure 1 of Neulander 2010 (PNG;
+//! its caption, the row and column names below, goes into `report.md`).
 //!
 //! ```text
 //!               no smoothing   LM07   edge-aware   edge-refined   ground truth
@@ -8,15 +9,18 @@
 //! error            ▢            ▢         ▢            ▢                   (relative, log
 //! error ×3         ▢            ▢         ▢            ▢                    scale, one white)
 //! ```
+//!
+//! The charts are drawn by [`charts`](super::charts).
 
 use std::path::Path;
 
+use super::charts::{ChartPoint, write_charts};
 use super::runner::{MethodSetting, Reference};
 use super::{BenchConfig, BenchError, BenchReport, BenchScene};
 use crate::output::heatmap::max_pixel_error;
 use crate::output::png::encode_srgb8;
 use crate::output::{ErrorMetric, HeatmapOptions, HeatmapScale, RgbImage, error_heatmap};
-use crate::plot::{Chart, Series, Sheet, SheetRow, Tile, crop_magnify, render_chart, render_sheet};
+use crate::plot::{Sheet, Tile, crop_magnify, render_sheet};
 use lucent_core::Method;
 
 /// Magnification of the shadow-edge insets.
@@ -25,8 +29,8 @@ const INSET_ZOOM: u32 = 3;
 /// Inset marker colour.
 const MARKER: [u8; 3] = [255, 220, 0];
 
-/// Writes `<scene>-error-vs-time.png`, `<scene>-edge-error-vs-time.png` and, when the sheet's
-/// images are all there, `<scene>-figure1.png`.
+/// Writes a scene's charts ([`write_charts`](super::write_charts)) and, when the sheet's images are all there,
+/// `<scene>-figure1.png`; returns the contact sheet's caption (Markdown) for the report.
 pub fn write_scene_figures(
     config: &BenchConfig,
     scene: BenchScene,
@@ -35,42 +39,24 @@ pub fn write_scene_figures(
     sheet_images: &[(MethodSetting, RgbImage)],
     exposure: f32,
     out: &Path,
-) -> Result<(), BenchError> {
-    for (edge, file, what) in [
-        (false, "error-vs-time", "translucent pixels"),
-        (true, "edge-error-vs-time", "shadow-edge band"),
-    ] {
-        let series = config
-            .settings()
-            .into_iter()
-            .map(|setting| Series {
-                label: setting.label(),
-                points: report
-                    .runs
-                    .iter()
-                    .filter(|r| r.scene == scene && r.setting == setting)
-                    .filter_map(|r| {
-                        let e = if edge {
-                            r.edge_error?.mean_relative_l1
-                        } else {
-                            r.error.mean_relative_l1
-                        };
-                        Some((r.timings.total.as_secs_f64(), e))
-                    })
-                    .collect(),
-            })
-            .collect();
-        let chart = Chart {
-            title: format!("{}: error against time ({what})", scene.name()),
-            x_label: "render time (s)".to_string(),
-            y_label: "mean relative error".to_string(),
-            series,
-            log_x: true,
-            log_y: true,
-        };
-        render_chart(&chart, 800, 560)?
-            .write_png(&out.join(format!("{}-{file}.png", scene.name())))?;
-    }
+) -> Result<Option<String>, BenchError> {
+    let points: Vec<ChartPoint> = config
+        .settings()
+        .into_iter()
+        .flat_map(|setting| {
+            report
+                .runs
+                .iter()
+                .filter(move |r| r.scene == scene && r.setting == setting)
+                .map(move |r| ChartPoint {
+                    label: setting.label(),
+                    time: r.timings.total.as_secs_f64(),
+                    error: r.error.mean_relative_l1,
+                    edge_error: r.edge_error.map(|e| e.mean_relative_l1),
+                })
+        })
+        .collect();
+    write_charts(scene.name(), &points, out)?;
 
     let pick = |method: Method| {
         sheet_images
@@ -88,11 +74,11 @@ pub fn write_scene_figures(
         pick(Method::EdgeAware),
         pick(Method::EdgeRefined),
     ) else {
-        return Ok(());
+        return Ok(None);
     };
-    let sheet = figure1(config, reference, [hier, lm, n10, refined], exposure)?;
+    let (sheet, caption) = figure1(config, reference, [hier, lm, n10, refined], exposure)?;
     render_sheet(&sheet)?.write_png(&out.join(format!("{}-figure1.png", scene.name())))?;
-    Ok(())
+    Ok(Some(caption))
 }
 
 /// The inset square: centred on the shadow-edge pixel nearest the band's centroid.
@@ -164,7 +150,7 @@ fn figure1(
     reference: &Reference,
     tests: [&RgbImage; 4],
     exposure: f32,
-) -> Result<Sheet, BenchError> {
+) -> Result<(Sheet, String), BenchError> {
     let (w, h) = reference.image.size();
     let rect = inset_rect(reference);
     // One white level for all four error maps: the largest per-pixel relative error.
@@ -206,40 +192,21 @@ fn figure1(
     error_maps.push(None);
     error_insets.push(None);
 
-    Ok(Sheet {
-        title: format!(
-            "{} samples, {}x{}: relative error, log scale over 3 decades, white = {:.1}%",
-            config.sheet_count,
-            w,
-            h,
-            white * 100.0
-        ),
-        column_labels: vec![
-            format!("no smoothing (JB02, eps {})", config.split_epsilon),
-            "LM07 (local-global)".to_string(),
-            "edge-aware (N10)".to_string(),
-            "edge-refined".to_string(),
-            "ground truth".to_string(),
-        ],
-        rows: vec![
-            SheetRow {
-                label: "image".to_string(),
-                tiles: images,
-            },
-            SheetRow {
-                label: format!("shadow edge x{INSET_ZOOM}"),
-                tiles: insets,
-            },
-            SheetRow {
-                label: "error".to_string(),
-                tiles: error_maps,
-            },
-            SheetRow {
-                label: format!("error x{INSET_ZOOM}"),
-                tiles: error_insets,
-            },
-        ],
-    })
+    let caption = format!(
+        "Columns: no smoothing (JB02, ε {}) · LM07 (local-global) · edge-aware (N10) · \
+         edge-refined · ground truth. Rows: image (the inset square in yellow) · shadow edge \
+         ×{INSET_ZOOM} · relative error · relative error ×{INSET_ZOOM}. {} samples, {}×{}; \
+         error on a log scale over 3 decades, white = {:.1}%.",
+        config.split_epsilon,
+        config.sheet_count,
+        w,
+        h,
+        white * 100.0
+    );
+    let sheet = Sheet {
+        rows: vec![images, insets, error_maps, error_insets],
+    };
+    Ok((sheet, caption))
 }
 
 #[cfg(test)]

@@ -13,7 +13,8 @@
 //!     sphere:   exhaustive sum at 18.5k samples vs hierarchical at several ε (speed claim)
 //!     textured: the power-of-two K table against K by quadrature at every pixel
 //!     default:  the shipped `lucent` render at 512², written to PNG + EXR, timed end to end
-//! report: report.md, results.csv, overhead.csv, <scene>-error-vs-time.png, <scene>-figure1.png
+//! report: report.md, results.csv, overhead.csv, <scene>-error-vs-time.svg,
+//!         <scene>-edge-error-vs-time.svg, <scene>-figure1.png
 //! ```
 //!
 //! **Ground truth.** The natural truth is the exhaustive sum over a sample set much denser
@@ -30,6 +31,7 @@
 //! sphere: hierarchical at ε = 0.05 is within 2e-5 of the exhaustive sum on the same
 //! samples.
 
+mod charts;
 mod figures;
 mod overhead;
 mod report;
@@ -41,6 +43,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+pub use charts::{ChartPoint, chart_files, replot, write_charts};
 pub use overhead::{OverheadRow, Spread};
 pub use report::{write_csv, write_markdown, write_overhead_csv};
 pub use runner::{MethodSetting, Reference, RunResult};
@@ -53,37 +56,109 @@ use crate::render::{RenderError, RenderOptions, render};
 use crate::scene::{SceneError, default_scene};
 use lucent_core::Method;
 
-/// Why the benchmark stopped.
+/// Why the benchmark stopped. Each variant that wraps another error returns it from
+/// [`source`](std::error::Error::source); the message is the wrapped error's own, which names
+/// the file or the problem already.
 #[derive(Debug)]
-pub struct BenchError(String);
+#[non_exhaustive]
+pub enum BenchError {
+    /// A setting is out of range, or a run is inconsistent (the message says which).
+    Invalid(String),
+    /// A benchmark scene could not be built.
+    Scene(SceneError),
+    /// A render failed.
+    Render(RenderError),
+    /// Writing or comparing images failed.
+    Output(OutputError),
+    /// Drawing a contact sheet or a chart failed.
+    Plot(PlotError),
+    /// The report folder could not be created.
+    CreateDir {
+        /// The folder.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// A file of an earlier report could not be read.
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// A `results.csv` to draw charts from is malformed.
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
 
 impl BenchError {
-    /// An error with a message.
+    /// An [`Invalid`](BenchError::Invalid) error with a message.
     pub fn new(message: impl Into<String>) -> Self {
-        BenchError(message.into())
+        BenchError::Invalid(message.into())
     }
 }
 
 impl fmt::Display for BenchError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
+        match self {
+            BenchError::Invalid(m) => f.write_str(m),
+            BenchError::Scene(e) => e.fmt(f),
+            BenchError::Render(e) => e.fmt(f),
+            BenchError::Output(e) => e.fmt(f),
+            BenchError::Plot(e) => e.fmt(f),
+            BenchError::CreateDir { path, source } => {
+                write!(f, "{}: cannot create: {source}", path.display())
+            }
+            BenchError::Read { path, source } => write!(f, "{}: {source}", path.display()),
+            BenchError::Csv {
+                path,
+                line,
+                message,
+            } => write!(f, "{} line {line}: {message}", path.display()),
+        }
     }
 }
 
-impl std::error::Error for BenchError {}
-
-/// Every step's error becomes a [`BenchError`] with its message (which names the file or the
-/// problem already).
-macro_rules! bench_error_from {
-    ($($source:ty),*) => {$(
-        impl From<$source> for BenchError {
-            fn from(e: $source) -> Self {
-                BenchError(e.to_string())
-            }
+impl std::error::Error for BenchError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            BenchError::Invalid(_) | BenchError::Csv { .. } => None,
+            BenchError::Scene(e) => Some(e),
+            BenchError::Render(e) => Some(e),
+            BenchError::Output(e) => Some(e),
+            BenchError::Plot(e) => Some(e),
+            BenchError::CreateDir { source, .. } | BenchError::Read { source, .. } => Some(source),
         }
-    )*};
+    }
 }
-bench_error_from!(OutputError, RenderError, SceneError, PlotError);
+
+// Every step's error becomes a `BenchError` that keeps it.
+impl From<OutputError> for BenchError {
+    fn from(e: OutputError) -> Self {
+        BenchError::Output(e)
+    }
+}
+impl From<PlotError> for BenchError {
+    fn from(e: PlotError) -> Self {
+        BenchError::Plot(e)
+    }
+}
+impl From<SceneError> for BenchError {
+    fn from(e: SceneError) -> Self {
+        BenchError::Scene(e)
+    }
+}
+impl From<RenderError> for BenchError {
+    fn from(e: RenderError) -> Self {
+        BenchError::Render(e)
+    }
+}
 
 /// What the benchmark runs.
 #[derive(Clone, Debug, PartialEq)]
@@ -336,6 +411,8 @@ pub struct BenchReport {
     pub table: Option<TableCheck>,
     /// The default scene end to end (render + PNG + EXR).
     pub end_to_end: Option<Duration>,
+    /// Per scene, the caption of its contact sheet (what its rows and columns show).
+    pub figure_captions: Vec<(BenchScene, String)>,
     /// Worker threads.
     pub threads: usize,
     /// Wall time of the whole benchmark.
@@ -351,8 +428,10 @@ pub fn run(
 ) -> Result<BenchReport, BenchError> {
     config.validate()?;
     let start = Instant::now();
-    std::fs::create_dir_all(out)
-        .map_err(|e| BenchError::new(format!("{}: cannot create: {e}", out.display())))?;
+    std::fs::create_dir_all(out).map_err(|source| BenchError::CreateDir {
+        path: out.to_path_buf(),
+        source,
+    })?;
     let mut report = BenchReport {
         config: config.clone(),
         truths: Vec::new(),
@@ -363,6 +442,7 @@ pub fn run(
         overhead: Vec::new(),
         table: None,
         end_to_end: None,
+        figure_captions: Vec::new(),
         threads: 0,
         wall: Duration::ZERO,
     };
@@ -500,7 +580,7 @@ fn run_scene(
             translucent: errors(&reference.translucent),
         });
     }
-    figures::write_scene_figures(
+    if let Some(caption) = figures::write_scene_figures(
         config,
         scene,
         report,
@@ -508,7 +588,9 @@ fn run_scene(
         &sheet_images,
         base.render.exposure,
         out,
-    )?;
+    )? {
+        report.figure_captions.push((scene, caption));
+    }
 
     match scene {
         BenchScene::Textured => {
@@ -691,8 +773,10 @@ fn exhaustive_check(
 /// The shipped default render, timed from loading the scene to the renamed output files.
 fn end_to_end(out: &Path, threads: Option<usize>) -> Result<Duration, BenchError> {
     let dir: PathBuf = out.join("default-scene");
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| BenchError::new(format!("{}: cannot create: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(|source| BenchError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let start = Instant::now();
     let mut scene = default_scene();
     scene.render.threads = threads;
@@ -709,7 +793,69 @@ fn end_to_end(out: &Path, threads: Option<usize>) -> Result<Duration, BenchError
 
 #[cfg(test)]
 mod tests {
+    use std::error::Error as _;
+
     use super::*;
+
+    #[test]
+    fn errors_keep_their_source_and_message() {
+        let dir = Path::new("/nonexistent/lucent-bench");
+        let e = replot(dir).unwrap_err();
+        assert!(matches!(e, BenchError::Read { .. }), "{e:?}");
+        assert!(e.to_string().contains("results.csv"), "{e}");
+        let io = e.source().and_then(|s| s.downcast_ref::<std::io::Error>());
+        assert_eq!(io.map(|e| e.kind()), Some(std::io::ErrorKind::NotFound));
+
+        let render = RenderError::Limit("too many triangles".into());
+        let e = BenchError::from(render);
+        assert_eq!(e.to_string(), "too many triangles");
+        assert!(
+            e.source()
+                .and_then(|s| s.downcast_ref::<RenderError>())
+                .is_some()
+        );
+        assert!(BenchError::new("bad").source().is_none());
+    }
+
+    #[test]
+    fn replot_rejects_a_malformed_table_by_line() {
+        let dir = std::env::temp_dir().join(format!("lucent-replot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let header = "scene,method,epsilon,smoothing,total_s,error_mean_rel,edge_mean_rel";
+        for (body, needle) in [
+            ("scene,method\n", "no column 'epsilon'"),
+            (
+                &*format!("{header}\nsphere,edge-aware,0.5,1.5,x,0.1,\n"),
+                "line 2: 'x' is not a number",
+            ),
+            (
+                &*format!("{header}\nsphere,edge-aware,0.5\n"),
+                "line 2: 3 cells",
+            ),
+            (
+                &*format!("{header}\n../x,edge-aware,0.5,1.5,1,0.1,\n"),
+                "not a scene name",
+            ),
+        ] {
+            std::fs::write(dir.join("results.csv"), body).unwrap();
+            let e = replot(&dir).unwrap_err().to_string();
+            assert!(e.contains(needle), "{e}");
+        }
+        // A good table: one series per method, the sweep's other k left out.
+        let rows = format!(
+            "{header}\nsphere,hierarchical,0.5,1.5,1,0.2,0.3\nsphere,edge-aware,0.5,1.5,2,0.1,\n\
+             sphere,edge-aware,0.5,3,4,0.05,\n"
+        );
+        std::fs::write(dir.join("results.csv"), rows).unwrap();
+        let files = replot(&dir).unwrap();
+        assert_eq!(files.len(), 2);
+        let svg = std::fs::read_to_string(&files[0]).unwrap();
+        assert!(svg.contains("data-label=\"hierarchical eps=0.5\""), "{svg}");
+        assert!(svg.contains("data-label=\"edge-aware\""), "{svg}");
+        // Two markers and the legend's two swatches: the row at k = 3 is not drawn.
+        assert_eq!(svg.matches("<circle cx").count(), 4, "{svg}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn presets_are_valid_and_their_sheet_count_is_run() {

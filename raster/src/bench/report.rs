@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::runner::{MethodSetting, RunResult};
 use super::{BenchError, BenchReport, BenchScene, SmoothingRow};
-use crate::output::{OutputError, write_atomically};
+use crate::output::write_text_atomically;
 use lucent_core::Method;
 
 /// The well-known C++ implementation's CPU per lookup on the sphere (µs) and its error
@@ -17,11 +17,7 @@ pub const REFERENCE_US_PER_LOOKUP: f64 = 26.0;
 pub const REFERENCE_ERROR: f64 = 0.006;
 
 fn write_file(path: &Path, text: &str) -> Result<(), BenchError> {
-    write_atomically(path, |f| {
-        f.write_all(text.as_bytes())
-            .map_err(|e| OutputError::io(path, "writing", e))
-    })?;
-    Ok(())
+    Ok(write_text_atomically(path, text)?)
 }
 
 fn pct(x: f64) -> String {
@@ -370,9 +366,15 @@ pub fn write_markdown(report: &BenchReport, path: &Path) -> Result<(), BenchErro
     }
     let _ = writeln!(s, "\n## Claims\n\n{}", claims(report));
     for &scene in &c.scenes {
+        let [chart, edge_chart] = super::chart_files(scene.name());
+        let caption = report
+            .figure_captions
+            .iter()
+            .find(|(s, _)| *s == scene)
+            .map_or(String::new(), |(_, c)| format!("\n\n{c}"));
         let _ = writeln!(
             s,
-            "\n## {}\n\n![error against time]({0}-error-vs-time.png)\n\n![figure 1]({0}-figure1.png)\n\n| method | samples | total | sampling | irradiance | cache | shading | CPU µs/lookup | nodes/lookup | evals/lookup | B/sample | error | RMSE | edge | noise |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+            "\n## {0}\n\n![error against time]({chart})\n\n![error against time, shadow-edge band]({edge_chart})\n\n![figure 1]({0}-figure1.png){caption}\n\n| method | samples | total | sampling | irradiance | cache | shading | CPU µs/lookup | nodes/lookup | evals/lookup | B/sample | error | RMSE | edge | noise |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
             scene.name()
         );
         for setting in c.settings() {

@@ -222,7 +222,7 @@ pub fn render_once(
         baked,
         ..RenderOptions::default()
     };
-    render(scene, &options).map_err(|e| BenchError::new(e.to_string()))
+    Ok(render(scene, &options)?)
 }
 
 /// Renders one configuration for every seed and measures it. Returns the result and the

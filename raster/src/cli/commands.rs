@@ -5,9 +5,12 @@ use std::path::Path;
 
 use lucent_core::{Profile, presets};
 
-use super::{BakeArgs, BenchArgs, RenderArgs, SamplesArg};
+#[cfg(feature = "harness")]
+use super::BenchArgs;
+use super::{BakeArgs, RenderArgs, SamplesArg};
+#[cfg(feature = "harness")]
 use crate::bench::{self, BenchConfig, BenchScene};
-use crate::output::{write_exr, write_png};
+use crate::output::{refuse_read_only, write_exr, write_png};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
     MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene, default_scene,
@@ -166,7 +169,8 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
 }
 
 /// Checks, before rendering, that every output path can be written: it names a file, its
-/// directory exists, it is not itself a directory, and no path is given twice. Each write is
+/// directory exists, it is not itself a directory nor a read-only file, and no path is given
+/// twice. Each write is
 /// atomic on its own, but a render writes the PNG and then the EXR: without this check, an EXR
 /// path in a missing directory failed only after the PNG had been replaced (exit 1 with a
 /// changed file), and the whole render was wasted.
@@ -192,6 +196,7 @@ fn check_outputs(paths: &[&Path]) -> Result<(), String> {
         if paths[..i].contains(path) {
             return Err(format!("{shown}: given as both the PNG and the EXR output"));
         }
+        refuse_read_only(path).map_err(|e| e.to_string())?;
     }
     Ok(())
 }
@@ -327,7 +332,17 @@ pub fn presets() -> Result<(), String> {
 }
 
 /// `lucent bench`.
+#[cfg(feature = "harness")]
 pub fn bench(args: &BenchArgs) -> Result<(), String> {
+    if args.replot {
+        let files = bench::replot(&args.output).map_err(|e| format!("bench: {e}"))?;
+        if !args.quiet {
+            for file in files {
+                eprintln!("{}", file.display());
+            }
+        }
+        return Ok(());
+    }
     let mut config = if args.quick {
         BenchConfig::quick()
     } else {

@@ -1,9 +1,11 @@
-//! The `lucent` command line: `render` (the default), `bake`, `presets`, `compare`, `bench`.
+//! The `lucent` command line: `render` (the default), `bake`, `presets`, and with the feature
+//! `harness` (on by default) `compare` and `bench`.
 //!
 //! Exit codes: 0 success, 1 a runtime error (bad scene, missing file, …; the message names the
 //! problem), 2 a usage error (unknown flag, malformed value; printed by clap).
 
 mod commands;
+#[cfg(feature = "harness")]
 mod compare;
 
 use std::path::PathBuf;
@@ -46,10 +48,12 @@ pub enum Command {
     /// Run time against error: render the benchmark scenes at several sample counts with
     /// every method, measure time, memory and error against a ground truth, and write a
     /// report folder (Markdown, CSV, plots, Figure-1 contact sheets).
+    #[cfg(feature = "harness")]
     Bench(BenchArgs),
     /// Compare two images (OpenEXR or PNG): RMSE, mean relative error, maximum error, over all
     /// pixels and, from the reference EXR's exitance and irradiance layers, over the
     /// translucent pixels and the band around shadow edges; optionally seed noise.
+    #[cfg(feature = "harness")]
     Compare(CompareArgs),
 }
 
@@ -167,11 +171,16 @@ pub struct BakeArgs {
 }
 
 /// Options of `bench`.
+#[cfg(feature = "harness")]
 #[derive(Debug, Args, Clone)]
 pub struct BenchArgs {
-    /// Where to write the report (report.md, results.csv, PNG plots and sheets).
+    /// Where to write the report (report.md, results.csv, SVG charts, PNG contact sheets).
     #[arg(short, long, value_name = "DIR", default_value = "bench-report")]
     pub output: PathBuf,
+    /// Run nothing: draw the error-against-time charts again from the results.csv in the
+    /// output folder (written by an earlier run).
+    #[arg(long)]
+    pub replot: bool,
     /// A small version (96², two sample counts) that finishes in well under a minute.
     #[arg(long)]
     pub quick: bool,
@@ -196,6 +205,7 @@ pub struct BenchArgs {
 }
 
 /// Options of `compare`.
+#[cfg(feature = "harness")]
 #[derive(Debug, Args, Clone)]
 pub struct CompareArgs {
     /// The image under test (.exr or .png).
@@ -232,7 +242,9 @@ pub fn main() -> i32 {
         Some(Command::Render(args)) => commands::render(&args),
         Some(Command::Bake(args)) => commands::bake(&args),
         Some(Command::Presets) => commands::presets(),
+        #[cfg(feature = "harness")]
         Some(Command::Compare(args)) => compare::compare(&args),
+        #[cfg(feature = "harness")]
         Some(Command::Bench(args)) => commands::bench(&args),
     };
     match result {

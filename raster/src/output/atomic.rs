@@ -1,15 +1,19 @@
 //! Atomic file replacement: a file is either completely written or not touched at all.
 //!
-//! [`write_atomically`] writes into a fresh temporary file in the target's directory (same
-//! file system, so the final rename is atomic on POSIX), flushes and fsyncs it, then renames
-//! it over the target. On any error — including a panic in the writer closure — the temporary
-//! file is removed and an existing target is left byte-identical. A reader never sees a
-//! half-written PNG, EXR or PLY, even if `lucent` is killed mid-write.
+//! [`write_atomically`] writes into a fresh temporary file in the target's directory
+//! (`tempfile::NamedTempFile`; the same file system, so the final rename is atomic on POSIX),
+//! flushes and fsyncs it, then renames it over the target. On any error — including a panic
+//! in the writer closure — the temporary file is removed and an existing target is left
+//! byte-identical. A reader never sees a half-written PNG, EXR, PLY, SVG or report, even if
+//! `lucent` is killed mid-write. Every file lucent writes goes through here.
+//!
+//! An existing target whose permissions say read-only is refused ([`OutputError::ReadOnly`])
+//! before anything is written: a rename replaces a file whatever its permissions, which would
+//! silently overwrite a result its owner protected.
 
-use std::fs::{self, File, OpenOptions};
-use std::io::{self, BufWriter, Seek, Write};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::fs::File;
+use std::io::{BufWriter, Seek, Write};
+use std::path::Path;
 
 use super::OutputError;
 
@@ -18,33 +22,12 @@ pub trait WriteSeek: Write + Seek {}
 
 impl<T: Write + Seek + ?Sized> WriteSeek for T {}
 
-/// Distinguishes temporary files of concurrent writes within one process.
-static COUNTER: AtomicU64 = AtomicU64::new(0);
-
-/// How many temporary names to try before giving up (only collisions with stale files from
-/// crashed processes of the same pid can make the first one fail).
-const NAME_ATTEMPTS: u32 = 64;
-
-/// Removes the temporary file on drop unless disarmed.
-struct TempGuard {
-    path: PathBuf,
-    armed: bool,
-}
-
-impl Drop for TempGuard {
-    fn drop(&mut self) {
-        if self.armed {
-            // Nothing sensible can be done if removal fails; the original error is reported.
-            let _ = fs::remove_file(&self.path);
-        }
-    }
-}
-
 /// Writes `path` atomically: `write` receives a buffered writer onto a temporary file in the
 /// same directory; when it returns `Ok`, the data is flushed, fsynced and renamed over `path`.
 ///
 /// Errors name `path` and the step that failed. When `write` fails, its error is returned
-/// unchanged. The parent directory must exist (it is not created).
+/// unchanged. The parent directory must exist (it is not created). An existing `path` that
+/// is read-only is not replaced: [`OutputError::ReadOnly`].
 pub fn write_atomically<F>(path: &Path, write: F) -> Result<(), OutputError>
 where
     F: FnOnce(&mut dyn WriteSeek) -> Result<(), OutputError>,
@@ -59,33 +42,48 @@ where
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
+    refuse_read_only(path)?;
 
-    let (file, temp_path) = create_temp(path, dir, file_name)?;
-    let mut guard = TempGuard {
-        path: temp_path,
-        armed: true,
-    };
+    // `.<name>.XXXXXX.tmp`: hidden, and recognisably the target's. The handle deletes the
+    // file when dropped — on every early return below and when `write` panics.
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(file_name);
+    prefix.push(".");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // NamedTempFile creates files readable by the owner only; an output file gets the usual
+    // permissions (0666 less the umask), like any file the user creates.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let temp = builder.tempfile_in(dir).map_err(|e| {
+        OutputError::io(
+            path,
+            format!("creating a temporary file in '{}' failed", dir.display()),
+            e,
+        )
+    })?;
 
-    let mut writer = BufWriter::new(file);
+    let mut writer = BufWriter::new(temp);
     write(&mut writer)?;
-    let file = writer
+    let temp = writer
         .into_inner()
         .map_err(|e| OutputError::io(path, "flushing the temporary file failed", e.into_error()))?;
-    file.sync_all()
+    temp.as_file()
+        .sync_all()
         .map_err(|e| OutputError::io(path, "syncing the temporary file to disk failed", e))?;
-    drop(file);
 
-    fs::rename(&guard.path, path).map_err(|e| {
+    let temp_path = temp.path().to_path_buf();
+    // On failure the error hands the temporary file back, and dropping it removes it.
+    temp.persist(path).map_err(|e| {
         OutputError::io(
             path,
             format!(
                 "renaming the temporary file '{}' over the target failed",
-                guard.path.display()
+                temp_path.display()
             ),
-            e,
+            e.error,
         )
     })?;
-    guard.armed = false;
 
     // Make the rename itself durable. Best effort: not every platform or file system lets a
     // directory be opened and synced, and the new file is already in place.
@@ -96,41 +94,37 @@ where
     Ok(())
 }
 
-/// Creates a new, empty temporary file `.<name>.<pid>-<n>.tmp` in `dir`.
-fn create_temp(
-    target: &Path,
-    dir: &Path,
-    file_name: &std::ffi::OsStr,
-) -> Result<(File, PathBuf), OutputError> {
-    let pid = std::process::id();
-    let mut last_error = None;
-    for _ in 0..NAME_ATTEMPTS {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let mut name = std::ffi::OsString::from(".");
-        name.push(file_name);
-        name.push(format!(".{pid}-{n}.tmp"));
-        let temp = dir.join(name);
-        match OpenOptions::new().write(true).create_new(true).open(&temp) {
-            Ok(f) => return Ok((f, temp)),
-            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last_error = Some(e),
-            Err(e) => {
-                return Err(OutputError::io(
-                    target,
-                    format!("creating a temporary file in '{}' failed", dir.display()),
-                    e,
-                ));
-            }
-        }
+/// Writes the text `text` to `path` atomically (see [`write_atomically`]): reports, CSV
+/// tables, SVG charts.
+pub fn write_text_atomically(path: &Path, text: &str) -> Result<(), OutputError> {
+    write_atomically(path, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|e| OutputError::io(path, "writing the file failed", e))
+    })
+}
+
+/// Fails with [`OutputError::ReadOnly`] when `path` exists and its permissions are
+/// read-only. The permission bits are checked, not a write attempted: the superuser may
+/// write any file, and the rename would replace it anyway. [`write_atomically`] checks this
+/// first; a command that writes several files checks them all before writing any.
+pub fn refuse_read_only(path: &Path) -> Result<(), OutputError> {
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_file() && meta.permissions().readonly() => Err(OutputError::ReadOnly {
+            path: path.to_path_buf(),
+        }),
+        // A missing target is the usual case; any other problem with it (a directory, no
+        // access) surfaces with its own message when the rename fails.
+        _ => Ok(()),
     }
-    Err(OutputError::io(
-        target,
-        format!("no free temporary file name in '{}'", dir.display()),
-        last_error.unwrap_or_else(|| io::Error::from(io::ErrorKind::AlreadyExists)),
-    ))
 }
 
 #[cfg(test)]
 pub(crate) mod tests {
+    use std::fs;
+    use std::io;
+    use std::path::PathBuf;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
     use super::*;
 
     /// A fresh, empty directory under the system temp dir, removed on drop.
@@ -259,5 +253,65 @@ pub(crate) mod tests {
             .filter(|e| e.file_name().to_string_lossy().contains(&name))
             .collect();
         assert!(leftovers.is_empty(), "{leftovers:?}");
+    }
+
+    #[test]
+    fn read_only_target_is_refused_and_kept() {
+        let dir = TestDir::new("atomic-readonly");
+        let target = dir.path("protected.png");
+        fs::write(&target, b"precious").unwrap();
+        let mut permissions = fs::metadata(&target).unwrap().permissions();
+        permissions.set_readonly(true);
+        fs::set_permissions(&target, permissions).unwrap();
+
+        let mut called = false;
+        let err = write_atomically(&target, |w| {
+            called = true;
+            w.write_all(b"replacement")
+                .map_err(|e| OutputError::io(&target, "write", e))
+        })
+        .unwrap_err();
+        let msg = err.to_string();
+        assert!(matches!(err, OutputError::ReadOnly { .. }), "{err:?}");
+        assert!(msg.contains("protected.png"), "{msg}");
+        assert!(msg.contains("read-only"), "{msg}");
+        assert!(!called, "nothing is written for a refused target");
+        // Checked by the bits: as root, the OS alone would let the write through.
+        assert!(fs::metadata(&target).unwrap().permissions().readonly());
+        assert_eq!(fs::read(&target).unwrap(), b"precious");
+        assert_eq!(dir.entries(), vec!["protected.png".to_string()]);
+
+        // Made writable again, it is replaced as usual.
+        let mut permissions = fs::metadata(&target).unwrap().permissions();
+        #[allow(clippy::permissions_set_readonly_false)]
+        permissions.set_readonly(false);
+        fs::set_permissions(&target, permissions).unwrap();
+        write_atomically(&target, |w| {
+            w.write_all(b"new")
+                .map_err(|e| OutputError::io(&target, "write", e))
+        })
+        .unwrap();
+        assert_eq!(fs::read(&target).unwrap(), b"new");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn new_files_get_the_usual_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = TestDir::new("atomic-mode");
+        let target = dir.path("m.bin");
+        write_atomically(&target, |_| Ok(())).unwrap();
+        let mode = fs::metadata(&target).unwrap().permissions().mode();
+        // Readable by the owner and, unless the umask forbids it (it never removes the
+        // owner's bits), not restricted to 0600 as a bare temporary file would be.
+        assert_eq!(mode & 0o600, 0o600, "{mode:o}");
+        let umask_allows_group_read = {
+            let probe = dir.path("probe");
+            fs::File::create(&probe).unwrap();
+            let m = fs::metadata(&probe).unwrap().permissions().mode();
+            fs::remove_file(&probe).unwrap();
+            m & 0o077
+        };
+        assert_eq!(mode & 0o077, umask_allows_group_read, "{mode:o}");
     }
 }

@@ -20,6 +20,11 @@ pub enum OutputError {
         /// The underlying error.
         source: io::Error,
     },
+    /// The output file exists and is read-only: lucent does not replace it.
+    ReadOnly {
+        /// The file.
+        path: PathBuf,
+    },
     /// The data handed to a writer (or decoded by a reader) does not describe a valid image or
     /// sample set, e.g. a pixel buffer of the wrong length or an invalid layer name.
     Invalid {
@@ -28,19 +33,26 @@ pub enum OutputError {
         /// What is wrong.
         message: String,
     },
-    /// The PNG encoder or decoder reported an error (malformed or unsupported file).
+    /// The PNG decoder reported an error (malformed or unsupported file).
     Png {
         /// The file.
         path: PathBuf,
-        /// The codec's message.
-        message: String,
+        /// The codec's error.
+        source: png::DecodingError,
+    },
+    /// The PNG encoder reported an error.
+    PngEncode {
+        /// The file.
+        path: PathBuf,
+        /// The codec's error.
+        source: png::EncodingError,
     },
     /// The OpenEXR encoder or decoder reported an error (malformed or unsupported file).
     Exr {
         /// The file.
         path: PathBuf,
-        /// The codec's message.
-        message: String,
+        /// The codec's error.
+        source: exr::error::Error,
     },
     /// A required channel is not in the file.
     MissingChannel {
@@ -140,6 +152,12 @@ impl fmt::Display for OutputError {
             } => {
                 write!(f, "{}: {action}: {source}", path.display())
             }
+            OutputError::ReadOnly { path } => write!(
+                f,
+                "{}: the file is read-only; lucent does not replace it (make it writable or \
+                 write elsewhere)",
+                path.display()
+            ),
             OutputError::Invalid { path, message } => {
                 if path.as_os_str().is_empty() {
                     write!(f, "{message}")
@@ -147,11 +165,14 @@ impl fmt::Display for OutputError {
                     write!(f, "{}: {message}", path.display())
                 }
             }
-            OutputError::Png { path, message } => {
-                write!(f, "{}: PNG error: {message}", path.display())
+            OutputError::Png { path, source } => {
+                write!(f, "{}: PNG error: {source}", path.display())
             }
-            OutputError::Exr { path, message } => {
-                write!(f, "{}: OpenEXR error: {message}", path.display())
+            OutputError::PngEncode { path, source } => {
+                write!(f, "{}: PNG error: {source}", path.display())
+            }
+            OutputError::Exr { path, source } => {
+                write!(f, "{}: OpenEXR error: {source}", path.display())
             }
             OutputError::MissingChannel {
                 path,
@@ -223,6 +244,9 @@ impl std::error::Error for OutputError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             OutputError::Io { source, .. } => Some(source),
+            OutputError::Png { source, .. } => Some(source),
+            OutputError::PngEncode { source, .. } => Some(source),
+            OutputError::Exr { source, .. } => Some(source),
             _ => None,
         }
     }

@@ -147,9 +147,9 @@ pub fn write_exr(path: &Path, beauty: &RgbImage, layers: &[Layer]) -> Result<(),
             .write()
             .non_parallel()
             .to_buffered(w)
-            .map_err(|e| OutputError::Exr {
+            .map_err(|source| OutputError::Exr {
                 path: path.to_path_buf(),
-                message: e.to_string(),
+                source,
             })
     })
 }
@@ -191,9 +191,9 @@ struct Channel {
 
 /// Decodes every channel of every part, largest resolution level only.
 fn load_channels(path: &Path) -> Result<Vec<Channel>, OutputError> {
-    let exr_err = |e: exr::error::Error| OutputError::Exr {
+    let exr_err = |source: exr::error::Error| OutputError::Exr {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        source,
     };
     let file = File::open(path).map_err(|e| OutputError::io(path, "opening the EXR failed", e))?;
     let mut reader = BufReader::new(file);

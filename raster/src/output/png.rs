@@ -69,9 +69,9 @@ pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Resul
             ),
         ));
     }
-    let png_err = |e: png::EncodingError| OutputError::Png {
+    let png_err = |source: png::EncodingError| OutputError::PngEncode {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        source,
     };
     write_atomically(path, |w| {
         let mut encoder = png::Encoder::new(w, width, height);
@@ -99,9 +99,9 @@ fn check_size(path: &Path, width: u32, height: u32) -> Result<(), OutputError> {
 /// Reads a PNG and converts it to linear RGB (see the module doc for what is accepted).
 pub fn read_png(path: &Path) -> Result<RgbImage, OutputError> {
     let file = File::open(path).map_err(|e| OutputError::io(path, "opening the PNG failed", e))?;
-    let png_err = |e: png::DecodingError| OutputError::Png {
+    let png_err = |source: png::DecodingError| OutputError::Png {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        source,
     };
 
     let mut decoder = png::Decoder::new_with_limits(
@@ -335,7 +335,10 @@ mod tests {
         let err = read_png(&dir.path("missing.png")).unwrap_err();
         assert!(err.to_string().contains("missing.png"), "{err}");
         std::fs::write(&path, b"definitely not a png").unwrap();
-        assert!(matches!(read_png(&path), Err(OutputError::Png { .. })));
+        let err = read_png(&path).unwrap_err();
+        assert!(matches!(err, OutputError::Png { .. }), "{err:?}");
+        let source = std::error::Error::source(&err).expect("the decoder's error");
+        assert!(source.downcast_ref::<png::DecodingError>().is_some());
         write_png(&path, &gradient(20, 20), 0.0).unwrap();
         let full = std::fs::read(&path).unwrap();
         for cut in [8, 20, 40, full.len() / 2, full.len() - 13] {

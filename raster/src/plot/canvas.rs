@@ -1,9 +1,8 @@
 //! [`Canvas`]: an opaque 8-bit RGB drawing surface over a `tiny_skia::Pixmap`.
 //!
-//! Lines and circles are anti-aliased `tiny-skia` paths; rectangles are filled without
-//! anti-aliasing so that frames and grid lines stay crisp; text is the [`font`]
-//! enlarged to whole-pixel blocks; images are copied pixel for pixel. All colours are opaque
-//! sRGB bytes, so the canvas stays opaque and [`Canvas::to_rgb8`] is exact.
+//! Rectangles are filled without anti-aliasing so that frames stay crisp; images are copied
+//! pixel for pixel. All colours are opaque sRGB bytes, so the canvas stays opaque and
+//! [`Canvas::to_rgb8`] is exact. (Text and charts are SVG: [`chart`](super::chart).)
 //!
 //! Drawing never fails and never panics: shapes are clipped to the canvas, and non-finite
 //! coordinates or non-positive sizes draw nothing. Only construction and image copies, which
@@ -14,10 +13,9 @@
 
 use std::path::Path;
 
-use tiny_skia::{Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke};
-use tiny_skia::{PremultipliedColorU8, Transform};
+use tiny_skia::{Color, Paint, Pixmap, Rect, Transform};
 
-use super::{PlotError, check_rgb_len, font};
+use super::{PlotError, check_rgb_len};
 use crate::output::OutputError;
 use crate::output::png::write_png_rgb8;
 
@@ -102,119 +100,6 @@ impl Canvas {
         self.fill_rect(x + w - t, y + t, t, h - 2.0 * t, rgb);
     }
 
-    /// Draws an anti-aliased line `line_width` pixels wide through `points`, with round
-    /// joins and caps.
-    ///
-    /// A non-finite point breaks the line: the parts before and after it are drawn
-    /// separately. Segments are clipped to the neighbourhood of the canvas, so far-away
-    /// points keep the direction of the visible part. Fewer than two usable points, or a
-    /// width that is not positive, draw nothing; widths beyond `4 · MAX_SIDE` are treated as
-    /// `4 · MAX_SIDE`.
-    pub fn stroke_polyline(&mut self, points: &[(f32, f32)], rgb: [u8; 3], line_width: f32) {
-        if !(line_width > 0.0) {
-            return;
-        }
-        let line_width = line_width.min(4.0 * MAX_SIDE as f32);
-        let margin = line_width / 2.0 + 2.0;
-        let bounds = (
-            -margin,
-            -margin,
-            self.width() as f32 + margin,
-            self.height() as f32 + margin,
-        );
-        let mut builder = PathBuilder::new();
-        let mut pen: Option<(f32, f32)> = None;
-        for pair in points.windows(2) {
-            let (a, b) = (pair[0], pair[1]);
-            let finite = |p: (f32, f32)| p.0.is_finite() && p.1.is_finite();
-            if !finite(a) || !finite(b) {
-                pen = None;
-                continue;
-            }
-            let Some((from, to)) = clip_segment(a, b, bounds) else {
-                pen = None;
-                continue;
-            };
-            if pen != Some(from) {
-                builder.move_to(from.0, from.1);
-            }
-            builder.line_to(to.0, to.1);
-            // The next segment continues this sub-path only when it was not clipped here.
-            pen = (to == b).then_some(to);
-        }
-        let Some(path) = builder.finish() else {
-            return;
-        };
-        let stroke = Stroke {
-            width: line_width,
-            line_cap: LineCap::Round,
-            line_join: LineJoin::Round,
-            ..Stroke::default()
-        };
-        self.pixmap
-            .stroke_path(&path, &paint(rgb), &stroke, Transform::identity(), None);
-    }
-
-    /// Fills an anti-aliased disc of radius `r` centred on (`cx`, `cy`). Draws nothing for
-    /// non-finite values, `r ≤ 0`, or a disc entirely outside the canvas.
-    pub fn circle(&mut self, cx: f32, cy: f32, r: f32, rgb: [u8; 3]) {
-        if !(r > 0.0 && r.is_finite() && cx.is_finite() && cy.is_finite()) {
-            return;
-        }
-        let (w, h) = (self.width() as f32, self.height() as f32);
-        if cx + r < 0.0 || cy + r < 0.0 || cx - r > w || cy - r > h {
-            return;
-        }
-        if (cx - r <= -1.0 && cx + r >= w + 1.0 && cy - r <= -1.0 && cy + r >= h + 1.0)
-            && [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
-                .iter()
-                .all(|&(x, y)| (x - cx).hypot(y - cy) <= r - 1.0)
-        {
-            // The disc covers the whole canvas (a path this big may be beyond tiny-skia's
-            // fixed-point range).
-            self.pixmap.fill(color(rgb));
-            return;
-        }
-        let Some(path) = PathBuilder::from_circle(cx, cy, r) else {
-            return;
-        };
-        self.pixmap.fill_path(
-            &path,
-            &paint(rgb),
-            FillRule::Winding,
-            Transform::identity(),
-            None,
-        );
-    }
-
-    /// Writes `text` with its top-left corner at (`x`, `y`), every font pixel enlarged to a
-    /// `scale × scale` block (see [`font`]). The text is [`font::text_width`]
-    /// wide and [`font::text_height`] tall; whatever falls outside the canvas is clipped.
-    pub fn text(&mut self, x: i32, y: i32, text: &str, scale: u32, rgb: [u8; 3]) {
-        let s = i64::from(scale);
-        for (u, v) in font::ink(text) {
-            let left = i64::from(x).saturating_add((u as i64).saturating_mul(s));
-            let top = i64::from(y) + i64::from(v) * s;
-            self.fill_block(left, top, s, s, rgb);
-        }
-    }
-
-    /// Writes `text` rotated 90° counter-clockwise (reading from bottom to top, as on a
-    /// y-axis label), with the top-left corner of its bounding box at (`x`, `y`). The box is
-    /// [`font::text_height`] wide and [`font::text_width`] tall; it is clipped like
-    /// [`text`](Self::text).
-    pub fn text_vertical(&mut self, x: i32, y: i32, text: &str, scale: u32, rgb: [u8; 3]) {
-        let s = i64::from(scale);
-        let cells = text.chars().count() as i64;
-        let length = (cells * i64::from(font::ADVANCE) - i64::from(font::SPACING)).max(0);
-        for (u, v) in font::ink(text) {
-            // Text column u becomes row (length − 1 − u); text row v becomes column v.
-            let row = (length - 1 - u as i64).saturating_mul(s);
-            let top = i64::from(y).saturating_add(row);
-            self.fill_block(i64::from(x) + i64::from(v) * s, top, s, s, rgb);
-        }
-    }
-
     /// Copies an 8-bit RGB image (`width × height` pixels, row-major, 3 bytes per pixel)
     /// with its top-left corner at (`x`, `y`), clipped to the canvas.
     ///
@@ -265,22 +150,6 @@ impl Canvas {
     pub fn write_png(&self, path: &Path) -> Result<(), OutputError> {
         write_png_rgb8(path, self.width(), self.height(), &self.to_rgb8())
     }
-
-    /// Sets the pixels of the rectangle at (`x`, `y`) of `w × h` pixels, clipped.
-    fn fill_block(&mut self, x: i64, y: i64, w: i64, h: i64, rgb: [u8; 3]) {
-        let (canvas_w, canvas_h) = (i64::from(self.width()), i64::from(self.height()));
-        let (x0, x1) = (x.clamp(0, canvas_w), x.saturating_add(w).clamp(0, canvas_w));
-        let (y0, y1) = (y.clamp(0, canvas_h), y.saturating_add(h).clamp(0, canvas_h));
-        let pixel = PremultipliedColorU8::from_rgba(rgb[0], rgb[1], rgb[2], 255);
-        let Some(pixel) = pixel else {
-            return; // Unreachable: an opaque colour is always a valid premultiplied one.
-        };
-        let pixels = self.pixmap.pixels_mut();
-        for row in y0..y1 {
-            let start = (row * canvas_w) as usize;
-            pixels[start + x0 as usize..start + x1 as usize].fill(pixel);
-        }
-    }
 }
 
 /// The opaque tiny-skia colour of `rgb`.
@@ -294,52 +163,6 @@ fn paint(rgb: [u8; 3]) -> Paint<'static> {
     paint.set_color(color(rgb));
     paint.anti_alias = true;
     paint
-}
-
-/// Clips the segment `a`–`b` to the rectangle `(left, top, right, bottom)` (Liang–Barsky);
-/// `None` when no part of it is inside. A clipped end is put exactly on the edge that cut
-/// it, which keeps very long segments (whose parameter along the segment is imprecise)
-/// accurate across the canvas.
-pub(super) fn clip_segment(
-    a: (f32, f32),
-    b: (f32, f32),
-    (left, top, right, bottom): (f32, f32, f32, f32),
-) -> Option<((f32, f32), (f32, f32))> {
-    // Work in f64: the coordinates may be up to f32::MAX and their differences overflow f32.
-    let (ax, ay, bx, by) = (a.0 as f64, a.1 as f64, b.0 as f64, b.1 as f64);
-    let (dx, dy) = (bx - ax, by - ay);
-    // The parameter of each end along a→b, and the edge that cut it: (is_vertical, position).
-    let mut start: (f64, Option<(bool, f64)>) = (0.0, None);
-    let mut end: (f64, Option<(bool, f64)>) = (1.0, None);
-    for (p, q, edge) in [
-        (-dx, ax - left as f64, (true, left as f64)),
-        (dx, right as f64 - ax, (true, right as f64)),
-        (-dy, ay - top as f64, (false, top as f64)),
-        (dy, bottom as f64 - ay, (false, bottom as f64)),
-    ] {
-        if p == 0.0 {
-            if q < 0.0 {
-                return None; // Parallel to this edge and outside it.
-            }
-        } else {
-            let t = q / p;
-            if p < 0.0 && t > start.0 {
-                start = (t, Some(edge));
-            } else if p > 0.0 && t < end.0 {
-                end = (t, Some(edge));
-            }
-        }
-    }
-    if start.0 > end.0 {
-        return None;
-    }
-    let point = |(_, edge): (f64, Option<(bool, f64)>), endpoint: (f32, f32)| match edge {
-        None => endpoint,
-        // A vertical edge cuts only segments with dx ≠ 0, a horizontal one only dy ≠ 0.
-        Some((true, x)) => (x as f32, (ay + (x - ax) * (dy / dx)) as f32),
-        Some((false, y)) => ((ax + (y - ay) * (dx / dy)) as f32, y as f32),
-    };
-    Some((point(start, a), point(end, b)))
 }
 
 /// Cuts the rectangle at (`x0`, `y0`) of `w × h` pixels out of an 8-bit RGB image of

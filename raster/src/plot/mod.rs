@@ -1,30 +1,30 @@
 //! 2-D drawing for benchmark reports.
 //!
 //! The report of `lucent bench` needs pictures: error-against-time curves for every method
-//! (log–log line charts) and the Figure-1-style contact sheet that puts the renders of
-//! several methods side by side, with magnified crops of the interesting regions. This
-//! module draws both, with no dependency beyond `tiny-skia` (anti-aliased paths) and the
-//! crate's own PNG writer.
+//! (log–log line charts, SVG text: the viewer draws lines and text at any size) and the
+//! Figure-1-style contact sheet that puts the renders of several methods side by side, with
+//! magnified crops of the interesting regions (PNG, drawn with `tiny-skia` and written by the
+//! crate's own PNG writer).
 //!
 //! | file | what |
 //! |---|---|
-//! | [`font`] | an embedded 5×7 bitmap font for printable ASCII, drawn at integer scales |
 //! | [`canvas`] | [`Canvas`]: an opaque RGB drawing surface; [`crop_magnify`] |
 //! | [`axis`] | [`Axis`]: data ranges, ticks and tick labels, linear or logarithmic |
-//! | [`chart`] | [`render_chart`]: line charts of error against time |
-//! | [`sheet`] | [`render_sheet`]: a labelled grid of image tiles (a contact sheet) |
+//! | [`chart`] | [`render_chart`]: line charts of error against time, as SVG |
+//! | [`sheet`] | [`render_sheet`]: a grid of image tiles (a contact sheet) |
+//! | [`xml`] | escaping chart text; [`check_well_formed`](xml::check_well_formed) |
 //!
 //! The tests are in `plot/tests/`, one file per module.
 //!
-//! Everything is deterministic (the same input draws the same pixels) and nothing panics on
-//! bad input: sizes, buffer lengths and crop rectangles are checked and reported as a
-//! [`PlotError`]; non-finite coordinates are skipped.
+//! Everything is deterministic (the same input draws the same pixels, or the same SVG text)
+//! and nothing panics on bad input: sizes, buffer lengths and crop rectangles are checked and
+//! reported as a [`PlotError`]; non-finite coordinates are skipped.
 
 pub mod axis;
 pub mod canvas;
 pub mod chart;
-pub mod font;
 pub mod sheet;
+pub mod xml;
 
 #[cfg(test)]
 mod tests;
@@ -34,7 +34,7 @@ use std::fmt;
 pub use axis::Axis;
 pub use canvas::{Canvas, MAX_SIDE, crop_magnify};
 pub use chart::{Chart, ChartLayout, PALETTE, Series, chart_layout, render_chart};
-pub use sheet::{Sheet, SheetLayout, SheetRow, Tile, render_sheet, sheet_layout};
+pub use sheet::{Sheet, SheetLayout, Tile, render_sheet, sheet_layout};
 
 /// What went wrong while drawing.
 #[derive(Debug, Clone, PartialEq, Eq)]

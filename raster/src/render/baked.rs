@@ -49,8 +49,7 @@ pub fn write_baked(
 /// Reads sample groups written by [`write_baked`]. Returns the groups and, per group, the
 /// object name it was baked for.
 pub fn read_baked(path: &Path) -> Result<Vec<(ObjectSamples, String)>, RenderError> {
-    let (all, comments) =
-        read_ply_with_comments(path).map_err(|e| RenderError::Baked(e.to_string()))?;
+    let (all, comments) = read_ply_with_comments(path).map_err(RenderError::BakedFile)?;
     let bad = |m: String| RenderError::Baked(format!("{}: {m}", path.display()));
     let mut groups = Vec::new();
     let mut next = 0usize;

@@ -135,7 +135,8 @@ mod tests {
         let lighting = Lighting::new(&lights, Some(&bvh), 2.0);
         let q = quadrature(&marble(), 0.08);
         assert!(q.shadow_skip() == 0.04);
-        let k = Vec3::new(0.3, 0.25, 0.2);
+        let local = LocalTerm::exact(&marble(), 0.08).unwrap();
+        let k = local.k();
         let e = lighting.irradiance(Vec3::ZERO, Vec3::Z, 0);
         assert_eq!(e, Vec3::ONE);
         let mut under = 0;
@@ -144,7 +145,7 @@ mod tests {
                 position: Vec3::ZERO,
                 normal: Vec3::Z,
                 irradiance: e,
-                k,
+                local,
                 seed,
             };
             let m = Exitance {

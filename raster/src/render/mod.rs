@@ -21,12 +21,12 @@ mod baked;
 mod convexity;
 pub mod density;
 mod edge_refined;
+mod error;
 mod irradiance;
 mod prepare;
 mod shading;
 
 use std::borrow::Cow;
-use std::fmt;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
@@ -39,52 +39,17 @@ pub use adaptive::{GroupScratch, ShadeGroup};
 pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
 pub use convexity::cannot_shadow_itself;
 pub use density::{DensityOrigin, DensityPlan};
+pub use error::RenderError;
 pub use irradiance::ObjectSamples;
 pub use prepare::{Prepared, can_occlude};
 pub use shading::{ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounters, ShadingStats};
 
 use crate::lights::Lighting;
-use crate::material::Shader;
+use crate::material::{MaterialError, Shader};
 use crate::output::image::{LAYER_EXITANCE, LAYER_GLOBAL, LAYER_IRRADIANCE, LAYER_LOCAL};
 use crate::output::{Layer, RgbImage};
-use crate::raster::{RasterError, VisibilityBuffer};
-use crate::sampling::SamplingError;
+use crate::raster::VisibilityBuffer;
 use crate::scene::Scene;
-
-/// Why a render failed.
-#[derive(Debug)]
-pub enum RenderError {
-    /// A material's parameters are invalid.
-    Material(String),
-    /// Irradiance samples could not be placed.
-    Sampling(SamplingError),
-    /// The image buffers could not be set up.
-    Raster(RasterError),
-    /// A baked sample set does not fit the scene.
-    Baked(String),
-    /// A scene exceeds an internal limit.
-    Limit(String),
-    /// The core rejected an input (a bug if it ever happens: inputs are validated).
-    Core(String),
-    /// The thread pool could not be started.
-    Threads(String),
-}
-
-impl fmt::Display for RenderError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            RenderError::Material(m) => write!(f, "{m}"),
-            RenderError::Sampling(e) => write!(f, "irradiance samples: {e}"),
-            RenderError::Raster(e) => write!(f, "image: {e}"),
-            RenderError::Baked(m) => write!(f, "baked samples: {m}"),
-            RenderError::Limit(m) => write!(f, "{m}"),
-            RenderError::Core(m) => write!(f, "internal error: {m}"),
-            RenderError::Threads(m) => write!(f, "thread pool: {m}"),
-        }
-    }
-}
-
-impl std::error::Error for RenderError {}
 
 /// Options beyond the scene's own settings.
 #[derive(Clone, Copy, Debug, Default)]
@@ -222,7 +187,7 @@ fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, RenderError>
     rayon::ThreadPoolBuilder::new()
         .num_threads(n.max(1))
         .build()
-        .map_err(|e| RenderError::Threads(e.to_string()))
+        .map_err(RenderError::Threads)
 }
 
 /// Places and lights the irradiance samples of a scene (what `lucent bake` writes).
@@ -340,7 +305,11 @@ fn render_in_pool(
             shader
                 .local_term(alpha, ell_min)
                 .map(Some)
-                .map_err(|e| RenderError::Material(format!("material '{}': {e}", shader.name)))
+                .map_err(|e| MaterialError::Params {
+                    material: shader.name.clone(),
+                    source: e,
+                })
+                .map_err(RenderError::Material)
         }
         _ => Ok(None),
     };
@@ -373,8 +342,7 @@ fn render_in_pool(
         if caches[object].is_none() {
             let alpha = settings.smoothing * spacing_area.sqrt();
             caches[object] = Some(ObjectCache::new(
-                IrradianceCache::build(&[])
-                    .map_err(|e| RenderError::Core(format!("empty irradiance cache: {e}")))?,
+                IrradianceCache::build(&[]).map_err(RenderError::Cache)?,
                 alpha,
                 local_term(object, alpha)?,
                 translucent_shader(object),
@@ -475,7 +443,7 @@ fn render_in_pool(
         camera.height,
         pixels.iter().map(|p| p.color).collect(),
     )
-    .map_err(|e| RenderError::Core(e.to_string()))?;
+    .map_err(RenderError::Image)?;
     Ok(Render {
         image,
         pixels,

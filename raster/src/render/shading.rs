@@ -22,7 +22,7 @@ use super::edge_refined::{self, RefinePoint};
 use super::prepare::Prepared;
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
-use crate::material::{LocalIntegral, Shader, TranslucentShader};
+use crate::material::{LocalIntegral, MaterialError, Shader, TranslucentShader};
 use crate::raster::{Fragment, VisibilityBuffer};
 use crate::sampling::rng::splitmix64;
 
@@ -56,7 +56,10 @@ impl ObjectCache {
         let (uniform_k, quadrature) = match (&local, shader) {
             (Some(term), Some(shader)) if !shader.is_textured() => {
                 let point = shader.at(Vec2::ZERO).map_err(|e| {
-                    RenderError::Material(format!("material '{}': {e}", shader.name))
+                    RenderError::Material(MaterialError::Params {
+                        material: shader.name.clone(),
+                        source: e,
+                    })
                 })?;
                 (
                     Some(term.exact(&point)),
@@ -284,7 +287,10 @@ impl Shading<'_> {
                     RenderError::Core(format!("no irradiance cache for object {object}"))
                 })?;
                 let point = shader.at(uv).map_err(|e| {
-                    RenderError::Material(format!("material '{}': {e}", shader.name))
+                    RenderError::Material(MaterialError::Params {
+                        material: shader.name.clone(),
+                        source: e,
+                    })
                 })?;
                 let method = self.settings.method;
                 let mut e = Vec3::ZERO;
@@ -308,7 +314,10 @@ impl Shading<'_> {
                 let local = match (&oc.local, oc.uniform_k) {
                     (Some(_), _) if self.exact_local_integral => {
                         LocalTerm::exact(&point.profile, oc.alpha).map_err(|e| {
-                            RenderError::Material(format!("material '{}': {e}", shader.name))
+                            RenderError::Material(MaterialError::Params {
+                                material: shader.name.clone(),
+                                source: e,
+                            })
                         })?
                     }
                     (Some(_), Some(term)) => term,
@@ -327,7 +336,7 @@ impl Shading<'_> {
                         &self.settings,
                         stats,
                     )
-                    .map_err(|err| RenderError::Core(format!("query at {position}: {err}")))?;
+                    .map_err(|source| RenderError::Query { position, source })?;
                 let m = if m.refine {
                     let q = oc
                         .quadrature

@@ -9,6 +9,10 @@
 
 use std::fmt;
 use std::ops::Range;
+use std::sync::Arc;
+
+/// The error behind a [`SceneError`], shared so that scene errors stay cheap to clone.
+pub type SceneErrorSource = Arc<dyn std::error::Error + Send + Sync + 'static>;
 
 /// What kind of problem a [`SceneError`] reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +40,10 @@ pub enum SceneErrorKind {
 }
 
 /// A scene that could not be loaded, with where and why.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// Two errors are equal when they say the same thing at the same place; their sources are
+/// not compared (their messages are part of `message` already).
+#[derive(Clone, Debug)]
 pub struct SceneError {
     /// The classification of the problem.
     pub kind: SceneErrorKind,
@@ -46,8 +53,38 @@ pub struct SceneError {
     pub position: Option<(usize, usize)>,
     /// Dotted key path (`camera.fov`, `object[0].scale`, `material.marble.eta`), when known.
     pub key: Option<String>,
-    /// What is wrong, with the offending value where there is one.
+    /// What is wrong, with the offending value where there is one (and the source's message,
+    /// if there is a source).
     pub message: String,
+    /// The error behind it, if one (a file's I/O error, the TOML parser's, the PNG decoder's,
+    /// the OBJ parser's): returned by [`source`](std::error::Error::source).
+    pub source: Option<SceneErrorSource>,
+}
+
+impl SceneError {
+    /// This error with `source` as the error behind it.
+    pub fn with_source(mut self, source: impl std::error::Error + Send + Sync + 'static) -> Self {
+        self.source = Some(Arc::new(source));
+        self
+    }
+}
+
+impl PartialEq for SceneError {
+    fn eq(&self, other: &Self) -> bool {
+        (
+            &self.kind,
+            &self.file,
+            &self.position,
+            &self.key,
+            &self.message,
+        ) == (
+            &other.kind,
+            &other.file,
+            &other.position,
+            &other.key,
+            &other.message,
+        )
+    }
 }
 
 impl fmt::Display for SceneError {
@@ -63,7 +100,13 @@ impl fmt::Display for SceneError {
     }
 }
 
-impl std::error::Error for SceneError {}
+impl std::error::Error for SceneError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.source
+            .as_deref()
+            .map(|e| e as &(dyn std::error::Error + 'static))
+    }
+}
 
 /// The text of a scene file and its display name: turns byte spans into located errors.
 #[derive(Clone, Copy, Debug)]
@@ -102,6 +145,7 @@ impl<'a> Source<'a> {
             position: Some(self.line_column(span.start)),
             key: Some(key.into()),
             message: message.into(),
+            source: None,
         }
     }
 
@@ -118,6 +162,7 @@ impl<'a> Source<'a> {
             position: None,
             key,
             message: message.into(),
+            source: None,
         }
     }
 
@@ -133,6 +178,7 @@ impl<'a> Source<'a> {
             position,
             key,
             message: format!("TOML syntax error: {}", err.message().trim()),
+            source: Some(Arc::new(err.clone())),
         }
     }
 
@@ -166,6 +212,7 @@ impl<'a> Source<'a> {
             position,
             key,
             message: friendly(&message),
+            source: Some(Arc::new(err.clone())),
         }
     }
 
@@ -262,6 +309,52 @@ mod tests {
     }
 
     #[test]
+    fn the_error_behind_is_the_source() {
+        use std::error::Error as _;
+        let dir = std::env::temp_dir().join(format!("lucent-scene-source-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A missing file: the I/O error.
+        let e = crate::scene::load_scene(&dir.join("missing.toml")).unwrap_err();
+        assert!(e.to_string().contains("cannot read scene: "), "{e}");
+        let io = e.source().and_then(|s| s.downcast_ref::<std::io::Error>());
+        assert_eq!(io.map(|e| e.kind()), Some(std::io::ErrorKind::NotFound));
+        // TOML syntax: the parser's error.
+        std::fs::write(dir.join("bad.toml"), "[camera\n").unwrap();
+        let e = crate::scene::load_scene(&dir.join("bad.toml")).unwrap_err();
+        assert!(e.to_string().contains("TOML syntax error"), "{e}");
+        assert!(
+            e.source()
+                .and_then(|s| s.downcast_ref::<toml::de::Error>())
+                .is_some()
+        );
+        // A mesh that does not exist: the I/O error, named at the scene key.
+        let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/default.toml");
+        let text = std::fs::read_to_string(shipped).unwrap();
+        assert!(text.contains("\"../assets/bunny.obj\""));
+        let text = text.replace("\"../assets/bunny.obj\"", "\"nowhere.obj\"");
+        std::fs::write(dir.join("mesh.toml"), text).unwrap();
+        let e = crate::scene::load_scene(&dir.join("mesh.toml")).unwrap_err();
+        assert_eq!(e.kind, SceneErrorKind::Io, "{e}");
+        assert!(e.to_string().contains("cannot read mesh"), "{e}");
+        assert!(e.to_string().contains("nowhere.obj"), "{e}");
+        let io = e.source().and_then(|s| s.downcast_ref::<std::io::Error>());
+        assert_eq!(io.map(|e| e.kind()), Some(std::io::ErrorKind::NotFound));
+        let _ = std::fs::remove_dir_all(&dir);
+        // Equality ignores the source.
+        let plain = SceneError {
+            kind: SceneErrorKind::Io,
+            file: "a.toml".into(),
+            position: None,
+            key: None,
+            message: "m".into(),
+            source: None,
+        };
+        let with = plain.clone().with_source(std::io::Error::other("x"));
+        assert_eq!(plain, with);
+        assert!(with.source().is_some() && plain.source().is_none());
+    }
+
+    #[test]
     fn display_has_file_position_key_and_message() {
         let e = SceneError {
             kind: SceneErrorKind::OutOfRange,
@@ -269,6 +362,7 @@ mod tests {
             position: Some((3, 7)),
             key: Some("camera.fov".into()),
             message: "must be in (0, 180) degrees (got 200)".into(),
+            source: None,
         };
         assert_eq!(
             e.to_string(),

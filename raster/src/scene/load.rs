@@ -33,9 +33,11 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
         position: None,
         key: None,
         message,
+        source: None,
     };
-    let bytes = read_limited(path, MAX_SCENE_BYTES)
-        .map_err(|why| file_error(SceneErrorKind::Io, format!("cannot read scene: {why}")))?;
+    let bytes = read_limited(path, MAX_SCENE_BYTES).map_err(|why| {
+        file_error(SceneErrorKind::Io, format!("cannot read scene: {why}")).with_source(why)
+    })?;
     let text = match String::from_utf8(bytes) {
         Ok(text) => text,
         Err(e) => {

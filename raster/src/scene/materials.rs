@@ -63,9 +63,12 @@ impl<'o> TextureCache<'o> {
                 file,
                 format!("cannot read texture {}: {why}", path.display()),
             )
+            .with_source(why)
         })?;
-        let texture = Texture::from_png_bytes(&bytes, &path, encoding)
-            .map_err(|e| c.at(SceneErrorKind::Texture, key, file, e.to_string()))?;
+        let texture = Texture::from_png_bytes(&bytes, &path, encoding).map_err(|e| {
+            c.at(SceneErrorKind::Texture, key, file, e.to_string())
+                .with_source(e)
+        })?;
         let texture = Arc::new(texture);
         self.loaded.insert((name, encoding), Arc::clone(&texture));
         Ok(texture)

@@ -17,12 +17,15 @@ use super::mesh::{drop_unused_vertices, smooth_normals, validate_mesh};
 use super::model::Mesh;
 
 /// Why an OBJ file could not be used.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ObjError {
     /// 1-based line in the OBJ file, when the problem has one.
     pub line: Option<usize>,
-    /// What is wrong.
+    /// What is wrong (with the parser's message, when the parser failed).
     pub message: String,
+    /// The OBJ parser's error, when it failed: returned by
+    /// [`source`](std::error::Error::source).
+    pub source: Option<tobj::LoadError>,
 }
 
 impl fmt::Display for ObjError {
@@ -34,7 +37,13 @@ impl fmt::Display for ObjError {
     }
 }
 
-impl std::error::Error for ObjError {}
+impl std::error::Error for ObjError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.source
+            .as_ref()
+            .map(|e| e as &(dyn std::error::Error + 'static))
+    }
+}
 
 /// Parses an OBJ file held in memory into one mesh in its own (object) coordinates.
 pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
@@ -47,6 +56,7 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
         ObjError {
             line: Some(line),
             message: "not UTF-8 text".to_string(),
+            source: None,
         }
     })?;
     check_indices(text)?;
@@ -63,6 +73,7 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
     .map_err(|e| ObjError {
         line: None,
         message: format!("malformed OBJ: {e}"),
+        source: Some(e),
     })?;
     merge(&models)
 }
@@ -72,6 +83,7 @@ fn merge(models: &[tobj::Model]) -> Result<Mesh, ObjError> {
     let fail = |message: String| ObjError {
         line: None,
         message,
+        source: None,
     };
     let mut mesh = Mesh::default();
     let mut normals = Vec::new();
@@ -176,6 +188,7 @@ fn check_indices(text: &str) -> Result<(), ObjError> {
                         let fail = |what: String| ObjError {
                             line: Some(number + 1),
                             message: what,
+                            source: None,
                         };
                         let Ok(index) = part.parse::<i64>() else {
                             return Err(fail(format!("bad face index `{part}`")));
@@ -287,6 +300,12 @@ f 1/1 2/2 3/3 4/4
         for (bytes, what) in cases {
             let err = parse_obj(bytes).expect_err(what);
             assert!(err.to_string().contains(what), "{what}: {err}");
+            // Only the parser's own failure has a source: its error.
+            let source = std::error::Error::source(&err);
+            assert_eq!(source.is_some(), what == "malformed OBJ", "{what}: {err}");
+            if let Some(source) = source {
+                assert!(source.downcast_ref::<tobj::LoadError>().is_some());
+            }
         }
     }
 

@@ -165,6 +165,7 @@ fn load_obj_file(
             file,
             format!("cannot read mesh {}: {why}", path.display()),
         )
+        .with_source(why)
     })?;
     parse_obj(&bytes).map_err(|e| {
         c.at(
@@ -173,6 +174,7 @@ fn load_obj_file(
             file,
             format!("in {}: {e}", path.display()),
         )
+        .with_source(e)
     })
 }
 

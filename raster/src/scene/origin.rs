@@ -69,7 +69,7 @@ impl SceneOrigin {
     }
 
     /// Reads a file referenced by the scene. The error is a human-readable reason.
-    pub fn read(&self, relative: &str) -> Result<Cow<'_, [u8]>, String> {
+    pub fn read(&self, relative: &str) -> Result<Cow<'_, [u8]>, std::io::Error> {
         match self {
             SceneOrigin::File(_) => {
                 read_limited(&self.resolve(relative), MAX_FILE_BYTES).map(Cow::Owned)
@@ -80,27 +80,34 @@ impl SceneOrigin {
                     .iter()
                     .find(|(name, _)| normalise(name) == wanted)
                     .map(|(_, bytes)| Cow::Borrowed(bytes.as_ref()))
-                    .ok_or_else(|| "no such file among the built-in files".to_string())
+                    .ok_or_else(|| {
+                        std::io::Error::new(
+                            std::io::ErrorKind::NotFound,
+                            "no such file among the built-in files",
+                        )
+                    })
             }
         }
     }
 }
 
 /// Reads a whole file, refusing files larger than `limit` bytes.
-pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let len = file.metadata().map_err(|e| e.to_string())?.len();
+pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, std::io::Error> {
+    let too_large =
+        |message: String| std::io::Error::new(std::io::ErrorKind::FileTooLarge, message);
+    let file = std::fs::File::open(path)?;
+    let len = file.metadata()?.len();
     if len > limit {
-        return Err(format!(
+        return Err(too_large(format!(
             "file is {len} bytes, larger than the {limit}-byte limit"
-        ));
+        )));
     }
     let mut bytes = Vec::with_capacity(len as usize);
-    file.take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| e.to_string())?;
+    file.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
-        return Err(format!("file is larger than the {limit}-byte limit"));
+        return Err(too_large(format!(
+            "file is larger than the {limit}-byte limit"
+        )));
     }
     Ok(bytes)
 }
@@ -125,7 +132,7 @@ mod tests {
         assert_eq!(o.stem(), "a");
         assert_eq!(o.source_path(), Some(PathBuf::from("scenes/a.toml")));
         let err = o.read("definitely-missing.obj").expect_err("missing");
-        assert!(!err.is_empty());
+        assert_eq!(err.kind(), std::io::ErrorKind::NotFound);
     }
 
     #[test]

@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use lucent_raster::bench::BenchScene;
+use lucent_raster::bench::{BenchScene, chart_files};
 use lucent_raster::output::read_png;
+use lucent_raster::plot::xml::check_well_formed;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("lucent-{name}-{}", std::process::id()));
@@ -33,6 +34,37 @@ fn check_png(path: &Path) {
         "{} is blank",
         path.display()
     );
+}
+
+/// An error-against-time chart: a well-formed SVG document with a line and a legend entry
+/// for every method.
+fn check_svg(path: &Path, labels: &[&str]) -> String {
+    let svg = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!(
+        check_well_formed(&svg),
+        Ok("svg".to_string()),
+        "{}",
+        path.display()
+    );
+    assert!(svg.contains("xmlns=\"http://www.w3.org/2000/svg\""));
+    assert!(svg.contains("error against time"), "{}", path.display());
+    for label in labels {
+        let group = format!("<g class=\"series\" data-label=\"{label}\"");
+        let start = svg
+            .find(&group)
+            .unwrap_or_else(|| panic!("{}: no series {label}", path.display()));
+        let body = &svg[start..start + svg[start..].find("</g>").unwrap()];
+        // Two sample counts: a line through two points.
+        assert!(body.contains("<polyline"), "{}: {label}", path.display());
+        assert_eq!(
+            body.matches("<circle").count(),
+            2,
+            "{}: {label}",
+            path.display()
+        );
+        assert!(svg.contains(&format!(">{label}</text>")), "legend {label}");
+    }
+    svg
 }
 
 #[test]
@@ -148,10 +180,41 @@ fn quick_bench_writes_a_complete_report() {
     ] {
         assert!(report.contains(needle), "report.md lacks '{needle}'");
     }
+    let labels = [
+        "hierarchical eps=0.5",
+        "local-global",
+        "edge-aware",
+        "edge-refined",
+    ];
+    let mut charts = Vec::new();
     for scene in BenchScene::ALL {
-        for file in ["error-vs-time", "edge-error-vs-time", "figure1"] {
-            check_png(&out.join(format!("{}-{file}.png", scene.name())));
+        check_png(&out.join(format!("{}-figure1.png", scene.name())));
+        for file in chart_files(scene.name()) {
+            assert!(
+                report.contains(&format!("]({file})")),
+                "report.md links {file}"
+            );
+            charts.push((out.join(&file), check_svg(&out.join(&file), &labels)));
         }
+        assert!(
+            report.contains("Columns: no smoothing"),
+            "the sheet's caption"
+        );
+    }
+
+    // The charts drawn again from results.csv are the same bytes.
+    for (path, _) in &charts {
+        std::fs::remove_file(path).unwrap();
+    }
+    let status = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["bench", "--replot", "--quiet", "-o"])
+        .arg(&out)
+        .status()
+        .expect("run lucent");
+    assert!(status.success(), "lucent bench --replot failed: {status}");
+    for (path, svg) in &charts {
+        let again = std::fs::read_to_string(path).unwrap();
+        assert_eq!(&again, svg, "{}", path.display());
     }
     let _ = std::fs::remove_dir_all(&out);
 }
@@ -176,5 +239,14 @@ fn bench_rejects_bad_options_with_a_message() {
         assert!(stderr.starts_with("error: "), "{args:?}: {stderr}");
     }
     assert!(!out.join("report.md").exists());
+    // Nothing to draw from: the missing results.csv is named.
+    let o = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["bench", "--replot", "-o"])
+        .arg(&out)
+        .output()
+        .expect("run lucent");
+    assert_eq!(o.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("results.csv"), "{stderr}");
     let _ = std::fs::remove_dir_all(&out);
 }

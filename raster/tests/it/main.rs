@@ -6,6 +6,8 @@
 //! Run one module with a filter, e.g. `cargo test -p lucent-raster --test it bad_input::`.
 
 mod bad_input;
+#[cfg(feature = "harness")]
 mod bench_quick;
+#[cfg(feature = "harness")]
 mod compare_regions;
 mod stress;

@@ -3,7 +3,7 @@
 use crate::plot::*;
 
 /// Writes a demonstration chart and contact sheet to the system temp directory
-/// (`plot-demo-chart.png`, `plot-demo-chart-linear.png`, `plot-demo-sheet.png`) for a visual check:
+/// (`plot-demo-chart.svg`, `plot-demo-chart-linear.svg`, `plot-demo-sheet.png`) for a visual check:
 /// `cargo test -p lucent-raster --lib plot::tests::demo -- --ignored`.
 #[test]
 #[ignore = "writes demonstration images for a visual check"]
@@ -35,10 +35,13 @@ fn demo() {
         log_y: true,
     };
     let dir = std::env::temp_dir();
-    render_chart(&chart, 800, 500)
-        .unwrap()
-        .write_png(&dir.join("plot-demo-chart.png"))
-        .unwrap();
+    let write = |name: &str, svg: String| {
+        crate::output::write_text_atomically(&dir.join(name), &svg).unwrap();
+    };
+    write(
+        "plot-demo-chart.svg",
+        render_chart(&chart, 800, 500).unwrap(),
+    );
     let linear = Chart {
         title: "Linear axes".into(),
         x_label: "samples".into(),
@@ -52,10 +55,10 @@ fn demo() {
         log_x: false,
         log_y: false,
     };
-    render_chart(&linear, 480, 300)
-        .unwrap()
-        .write_png(&dir.join("plot-demo-chart-linear.png"))
-        .unwrap();
+    write(
+        "plot-demo-chart-linear.svg",
+        render_chart(&linear, 480, 300).unwrap(),
+    );
 
     let image = |seed: u32| {
         let (w, h) = (192u32, 128u32);
@@ -70,7 +73,7 @@ fn demo() {
         (rgb, w, h)
     };
     let mut rows = Vec::new();
-    for (r, scene) in ["marble bust", "jade dragon"].iter().enumerate() {
+    for r in 0..2 {
         let mut tiles = Vec::new();
         for m in 0..3 {
             let (rgb, w, h) = image(r as u32 * 3 + m);
@@ -83,18 +86,9 @@ fn demo() {
         if r == 1 {
             tiles[1] = None;
         }
-        rows.push(SheetRow {
-            label: scene.to_string(),
-            tiles,
-        });
+        rows.push(tiles);
     }
-    let sheet = Sheet {
-        title: "Figure 1: reference and methods at equal time".into(),
-        column_labels: ["reference", "N10", "dipole", "dipole 4x"]
-            .map(String::from)
-            .to_vec(),
-        rows,
-    };
+    let sheet = Sheet { rows };
     render_sheet(&sheet)
         .unwrap()
         .write_png(&dir.join("plot-demo-sheet.png"))

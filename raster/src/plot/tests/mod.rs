@@ -4,8 +4,8 @@ mod axis;
 mod canvas;
 mod chart;
 mod demo;
-mod font;
 mod sheet;
+mod xml;
 
 use super::*;
 

@@ -1,6 +1,5 @@
-//! Tests of [`sheet`](crate::plot::sheet): layout, tile placement, labels and errors.
+//! Tests of [`sheet`](crate::plot::sheet): layout, tile placement and errors.
 
-use crate::plot::font::{ADVANCE, GLYPH_HEIGHT, SPACING, text_width};
 use crate::plot::sheet::*;
 use crate::plot::{Canvas, PlotError};
 
@@ -15,21 +14,12 @@ fn tile(width: u32, height: u32, seed: u8) -> Tile {
     Tile::new(rgb, width, height).unwrap()
 }
 
-fn row(label: &str, tiles: Vec<Option<Tile>>) -> SheetRow {
-    SheetRow {
-        label: label.into(),
-        tiles,
-    }
-}
-
-/// Two columns, two rows, one empty cell, small tiles (text scale 1).
+/// Two columns, two rows, one empty cell, small tiles.
 fn small_sheet() -> Sheet {
     Sheet {
-        title: "T".into(),
-        column_labels: vec!["ref".into(), "a".into()],
         rows: vec![
-            row("r1", vec![Some(tile(30, 20, 1)), None]),
-            row("row 2", vec![Some(tile(10, 40, 2)), Some(tile(24, 8, 3))]),
+            vec![Some(tile(30, 20, 1)), None],
+            vec![Some(tile(10, 40, 2)), Some(tile(24, 8, 3))],
         ],
     }
 }
@@ -47,16 +37,10 @@ fn assert_tile_at(canvas: &Canvas, tile: &Tile, x0: u32, y0: u32) {
 #[test]
 fn layout_matches_the_hand_computed_one() {
     let layout = sheet_layout(&small_sheet()).unwrap();
-    assert_eq!(layout.text_scale, 1);
-    let chars = |n: u32| n * ADVANCE - SPACING; // text width at scale 1
-    // Left margin: "row 2" plus the gap. Columns: 30 wide, then 24 wide.
-    let x0 = MARGIN + chars(5) + LABEL_GAP;
+    // Columns 30 and 24 wide, rows 20 and 40 tall, from the margin, a gutter apart.
+    let (x0, y0) = (MARGIN, MARGIN);
     assert_eq!(layout.column_x, [x0, x0 + 30 + GUTTER]);
     assert_eq!(layout.column_widths, [30, 24]);
-    // Title at scale 2 with its gaps, then the column labels, then rows 20 and 40 tall.
-    let title = 2 * GLYPH_HEIGHT + 2 * LABEL_GAP;
-    assert_eq!(layout.column_label_y, MARGIN + title);
-    let y0 = MARGIN + title + GLYPH_HEIGHT + LABEL_GAP;
     assert_eq!(layout.row_y, [y0, y0 + 20 + GUTTER]);
     assert_eq!(layout.row_heights, [20, 40]);
     assert_eq!(layout.width, x0 + 30 + GUTTER + 24 + MARGIN);
@@ -94,32 +78,9 @@ fn tiles_appear_centred_in_their_cells() {
 }
 
 #[test]
-fn labels_are_light_and_in_the_margins() {
-    let sheet = small_sheet();
-    let layout = sheet_layout(&sheet).unwrap();
-    let canvas = render_sheet(&sheet).unwrap();
-    let text_in = |x0: u32, y0: u32, w: u32, h: u32| {
-        (y0..y0 + h)
-            .flat_map(|y| (x0..x0 + w).map(move |x| (x, y)))
-            .filter(|&(x, y)| canvas.pixel(x, y) == Some(TEXT))
-            .count()
-    };
-    // Row label "r1", column labels, title.
-    assert!(text_in(MARGIN, layout.row_y[0], layout.column_x[0] - MARGIN, 20) > 10);
-    let (cx, cw) = (layout.column_x[0], layout.column_widths[0]);
-    assert!(text_in(cx, layout.column_label_y, cw, GLYPH_HEIGHT) > 10);
-    assert!(text_in(0, MARGIN, layout.width, 2 * GLYPH_HEIGHT) > 10);
-    // A column label wider than its tiles widens the column.
-    let mut wide = sheet.clone();
-    wide.column_labels[1] = "a much longer label".into();
-    let layout = sheet_layout(&wide).unwrap();
-    assert_eq!(layout.column_widths[1], 19 * ADVANCE - SPACING);
-}
-
-#[test]
 fn bad_tiles_are_reported() {
     let mut sheet = small_sheet();
-    sheet.rows[1].tiles[1] = Some(Tile {
+    sheet.rows[1][1] = Some(Tile {
         rgb: vec![0; 10],
         width: 2,
         height: 2,
@@ -141,7 +102,7 @@ fn bad_tiles_are_reported() {
         "contact-sheet tile at row 1, column 1: an 8-bit RGB image of 2x2 pixels needs 12 \
          bytes, got 10"
     );
-    sheet.rows[1].tiles[1] = Some(Tile {
+    sheet.rows[1][1] = Some(Tile {
         rgb: Vec::new(),
         width: 0,
         height: 5,
@@ -155,11 +116,7 @@ fn bad_tiles_are_reported() {
 fn oversized_sheets_are_errors() {
     let wide = Tile::new(vec![0; 3 * 6000], 6000, 1).unwrap();
     let sheet = Sheet {
-        rows: vec![row(
-            "",
-            vec![Some(wide.clone()), Some(wide.clone()), Some(wide)],
-        )],
-        ..Sheet::default()
+        rows: vec![vec![Some(wide.clone()), Some(wide.clone()), Some(wide)]],
     };
     assert!(matches!(
         render_sheet(&sheet),
@@ -172,33 +129,27 @@ fn degenerate_sheets_still_render() {
     let empty = render_sheet(&Sheet::default()).unwrap();
     assert_eq!((empty.width(), empty.height()), (2 * MARGIN, 2 * MARGIN));
     let ragged = Sheet {
-        title: "a title much wider than the grid".into(),
-        column_labels: vec!["one".into(), String::new(), "three".into(), "four".into()],
-        rows: vec![
-            row("", vec![]),
-            row("x", vec![None, Some(tile(3, 3, 9))]),
-            row("", vec![None]),
-        ],
+        rows: vec![vec![], vec![None, Some(tile(3, 3, 9))], vec![None]],
     };
     let layout = sheet_layout(&ragged).unwrap();
-    assert_eq!(layout.column_x.len(), 4);
-    assert_eq!(layout.row_heights, [0, GLYPH_HEIGHT, 0]);
+    assert_eq!(layout.column_x.len(), 2);
+    assert_eq!(layout.row_heights, [0, 3, 0]);
+    assert_eq!(layout.column_widths, [0, 3]);
     let canvas = render_sheet(&ragged).unwrap();
-    assert_eq!(canvas.width(), text_width(&ragged.title, 2) + 2 * MARGIN);
+    assert_eq!(
+        (canvas.width(), canvas.height()),
+        (
+            MARGIN + GUTTER + 3 + MARGIN,
+            MARGIN + 3 + 2 * GUTTER + MARGIN
+        )
+    );
     let (x, y) = layout.tile_origin(1, 1, 3, 3).unwrap();
     assert_tile_at(&canvas, &tile(3, 3, 9), x, y);
     assert_eq!(canvas.to_rgb8(), render_sheet(&ragged).unwrap().to_rgb8());
 }
 
 #[test]
-fn large_tiles_get_larger_text() {
-    let sheet = Sheet {
-        title: "big".into(),
-        column_labels: vec!["m".into()],
-        rows: vec![row("r", vec![Some(tile(160, 100, 0))])],
-    };
-    let layout = sheet_layout(&sheet).unwrap();
-    assert_eq!(layout.text_scale, 2);
+fn a_canvas_becomes_a_tile() {
     let canvas = Canvas::new(1, 1, BACKGROUND).unwrap();
     assert_eq!(
         Tile::from_canvas(&canvas),
