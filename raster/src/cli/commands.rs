@@ -243,7 +243,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
     if !args.quiet {
         let s = &result.stats;
         let t = &s.timings;
-        println!(
+        outln!(
             "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
             scene.camera.width,
             scene.camera.height,
@@ -299,7 +299,7 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
     if !args.quiet {
         let n: usize = sets.iter().map(|s| s.len()).sum();
         let how = plan.map_or(String::new(), |d| format!(" ({})", d.describe()));
-        println!(
+        outln!(
             "lucent bake: {n} samples{how} on {} objects in {} → {}",
             sets.len(),
             seconds(start.elapsed()),
@@ -311,21 +311,35 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
 
 /// `lucent presets`.
 pub fn presets() -> Result<(), String> {
-    println!(
+    outln!(
         "Measured materials of Jensen et al. 2001; coefficients per mm (scale with mm_per_unit)."
     );
-    println!(
+    outln!(
         "{:<10} {:>22} {:>24} {:>5} {:>20}",
-        "name", "σ_s′ R G B", "σ_a R G B", "η", "Rd_total R G B"
+        "name",
+        "σ_s′ R G B",
+        "σ_a R G B",
+        "η",
+        "Rd_total R G B"
     );
     for p in &presets::PRESETS {
         let rd = Profile::from_preset(p, 1.0)
             .map_err(|e| format!("preset {}: {e}", p.name))?
             .total_reflectance();
         let [s, a] = [p.sigma_s_prime, p.sigma_a];
-        println!(
+        outln!(
             "{:<10} {:>6.2} {:>6.2} {:>6.2}   {:>7.4} {:>7.4} {:>7.4} {:>5.2} {:>6.3} {:>6.3} {:>6.3}",
-            p.name, s[0], s[1], s[2], a[0], a[1], a[2], p.eta, rd.x, rd.y, rd.z
+            p.name,
+            s[0],
+            s[1],
+            s[2],
+            a[0],
+            a[1],
+            a[2],
+            p.eta,
+            rd.x,
+            rd.y,
+            rd.z
         );
     }
     Ok(())

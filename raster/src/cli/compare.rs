@@ -56,8 +56,8 @@ fn read(path: &Path) -> Result<Loaded, String> {
 }
 
 /// The rows printed for one region.
-fn print_stats(region: &str, s: &ErrorStats) {
-    println!(
+fn print_stats(region: &str, s: &ErrorStats) -> Result<(), String> {
+    outln!(
         "{region:<18} {:>8}  {:>12.6e}  {:>12.6e}  {:>12.6e}  {:>12.6e} at ({}, {}) {}",
         s.pixels,
         s.rmse,
@@ -68,6 +68,7 @@ fn print_stats(region: &str, s: &ErrorStats) {
         s.max_abs_at.1,
         ["R", "G", "B"][s.max_abs_channel]
     );
+    Ok(())
 }
 
 /// `lucent compare`.
@@ -76,11 +77,16 @@ pub fn compare(args: &CompareArgs) -> Result<(), String> {
     let reference = read(&args.reference)?;
     let (width, height) = reference.image.size();
     let whole = compare_images(&test.image, &reference.image, None).map_err(|e| e.to_string())?;
-    println!(
+    outln!(
         "{:<18} {:>8}  {:>12}  {:>12}  {:>12}  {:>12}",
-        "region", "pixels", "RMSE", "mean |error|", "mean rel. L1", "max |error|"
+        "region",
+        "pixels",
+        "RMSE",
+        "mean |error|",
+        "mean rel. L1",
+        "max |error|"
     );
-    print_stats("all pixels", &whole);
+    print_stats("all pixels", &whole)?;
 
     let translucent = reference
         .exitance
@@ -91,7 +97,7 @@ pub fn compare(args: &CompareArgs) -> Result<(), String> {
         Some(mask) => {
             let s = compare_images(&test.image, &reference.image, Some(mask))
                 .map_err(|e| e.to_string())?;
-            print_stats("translucent", &s);
+            print_stats("translucent", &s)?;
             match &reference.irradiance {
                 Some(e) => {
                     let radius = default_band_radius(width, height);
@@ -100,17 +106,17 @@ pub fn compare(args: &CompareArgs) -> Result<(), String> {
                     if band.contains(&true) {
                         let s = compare_images(&test.image, &reference.image, Some(&band))
                             .map_err(|e| e.to_string())?;
-                        print_stats(&format!("shadow edge ±{radius}px"), &s);
+                        print_stats(&format!("shadow edge ±{radius}px"), &s)?;
                     } else {
-                        println!("(no shadow edge in the reference's irradiance layer)");
+                        outln!("(no shadow edge in the reference's irradiance layer)");
                     }
                 }
-                None => println!(
+                None => outln!(
                     "(the reference has no '{LAYER_IRRADIANCE}' layer: no shadow-edge statistics)"
                 ),
             }
         }
-        None => println!(
+        None => outln!(
             "(the reference has no '{LAYER_EXITANCE}' layer with translucent pixels: whole-image statistics only)"
         ),
     }
@@ -132,7 +138,7 @@ pub fn compare(args: &CompareArgs) -> Result<(), String> {
         let mut renders = vec![&test.image];
         renders.extend(others.iter());
         let noise = seed_noise(&renders, translucent.as_deref()).map_err(|e| e.to_string())?;
-        println!(
+        outln!(
             "seed noise over {} renders, {} {} pixels: RMS {:.6e}, mean relative {:.6e}",
             noise.renders,
             noise.pixels,
@@ -163,7 +169,7 @@ pub fn compare(args: &CompareArgs) -> Result<(), String> {
         let map = error_heatmap(&test.image, &reference.image, None, &options)
             .map_err(|e| e.to_string())?;
         map.write_png(out).map_err(|e| e.to_string())?;
-        println!(
+        outln!(
             "heat map           {} (white = {:.3e})",
             out.display(),
             map.white

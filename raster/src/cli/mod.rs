@@ -4,6 +4,16 @@
 //! Exit codes: 0 success, 1 a runtime error (bad scene, missing file, …; the message names the
 //! problem), 2 a usage error (unknown flag, malformed value; printed by clap).
 
+/// `println!` for the command's report on standard output, in a function returning
+/// `Result<(), String>`: a reader that closed the pipe (`lucent compare a.exr b.exr | head -1`)
+/// has seen what it wanted, so that ends the output quietly; any other write error is the
+/// command's error.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::cli::write_line(format_args!($($arg)*))?
+    };
+}
+
 mod commands;
 #[cfg(feature = "harness")]
 mod compare;
@@ -13,6 +23,17 @@ use std::path::PathBuf;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand};
 use lucent_core::Method;
+
+/// Writes one line to standard output (see [`outln`]).
+fn write_line(line: std::fmt::Arguments) -> Result<(), String> {
+    use std::io::Write;
+    match writeln!(std::io::stdout().lock(), "{line}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(format!("cannot write to standard output: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
 
 /// Render translucent materials: point-based subsurface scattering (Jensen & Buhler 2002,
 /// Langlands & Mertens 2007, Neulander 2010).

@@ -142,3 +142,20 @@ fn compare_bad_images() {
         sb.fails(&all, 1, needles);
     }
 }
+
+/// A reader that closes the pipe before the report comes (`lucent presets | head -0`): the
+/// output ends quietly with status 0, not a panic on the broken pipe.
+#[test]
+fn a_closed_standard_output_is_not_a_crash() {
+    let (reader, writer) = std::io::pipe().unwrap();
+    // Closed before the child starts: its every write fails with a broken pipe.
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .arg("presets")
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
