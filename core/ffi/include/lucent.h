@@ -32,9 +32,9 @@ typedef enum LucentStatus {
    */
   LUCENT_UNKNOWN_PRESET = 3,
   /**
-   * A valid request that the C interface does not offer: the edge-refined method, whose
-   * local term is a quadrature of irradiance the caller evaluates at points the query
-   * chooses (use edge-aware, or lucent-core from Rust).
+   * A valid request that the call cannot serve: an edge-refined plan given to
+   * `lucent_query_point` or `lucent_query_points`, which have no irradiance callback (use
+   * `lucent_query_point_refined`).
    */
   LUCENT_UNSUPPORTED = 4,
   /**
@@ -42,12 +42,15 @@ typedef enum LucentStatus {
    * state is unchanged (handles stay valid), but this is a bug: please report the message.
    */
   LUCENT_PANIC = 5,
+  /**
+   * The caller's irradiance callback returned non-zero: the query was abandoned and nothing
+   * was written (the message names the node and the value returned).
+   */
+  LUCENT_CALLBACK_FAILED = 6,
 } LucentStatus;
 
 /**
- * Which sum a query evaluates (`LucentQueryOptions.method`). The value 4 is the
- * edge-refined method, which needs irradiance evaluated by the caller at quadrature points the
- * query picks; the C interface does not offer it and answers `LUCENT_UNSUPPORTED`.
+ * Which sum a query evaluates (`LucentQueryOptions.method`).
  */
 typedef enum LucentMethod {
   /**
@@ -67,6 +70,13 @@ typedef enum LucentMethod {
    * Every sample, no approximation: the reference, and slow.
    */
   LUCENT_METHOD_EXHAUSTIVE = 3,
+  /**
+   * Edge-aware, except where the samples' irradiance within α is not uniform (a shadow
+   * edge): there the local term is a quadrature of the irradiance that the caller
+   * evaluates at nodes around x (`docs/physics.md` §16). Queried only with
+   * `lucent_query_point_refined`, which takes the callback.
+   */
+  LUCENT_METHOD_EDGE_REFINED = 4,
 } LucentMethod;
 
 /**
@@ -143,7 +153,7 @@ typedef struct LucentQueryOptions {
    */
   uint32_t method;
   /**
-   * k in the smoothing radius α = k·√Ā of local-global and edge-aware (Ā the cache's mean
+   * k in the smoothing radius α = k·√Ā of the split methods (Ā the cache's mean
    * sample area; N10 suggests 1 to 4), finite and ≥ 0. Ignored by the other methods.
    */
   float smoothing_factor;
@@ -173,7 +183,8 @@ typedef struct LucentShadingPoint {
   float position[3];
   /**
    * Irradiance E(x) at x itself per RGB channel, finite and ≥ 0 (the local-global
-   * method's local term is E(x)·K; edge-aware weighs it in; the others ignore it).
+   * method's local term is E(x)·K; edge-aware and edge-refined weigh it in; the others
+   * ignore it).
    */
   float irradiance[3];
 } LucentShadingPoint;
@@ -201,10 +212,35 @@ typedef struct LucentExitance {
   float global[3];
   /**
    * The irradiance that drives the local term: E(x) for local-global, the kernel-weighted
-   * E_loc for edge-aware, zero for the others.
+   * E_loc for edge-aware (and edge-refined where it is not refined), local / K where
+   * edge-refined refines it, zero for the others.
    */
   float local_irradiance[3];
 } LucentExitance;
+
+/**
+ * The caller's irradiance at a point, for the edge-refined local term: writes E per RGB
+ * channel (finite, ≥ 0, the same radiometric unit as the samples' irradiance) at `position`
+ * on a surface facing `normal` to `irradiance[0..3]`, and returns 0; any other value
+ * abandons the query (`LUCENT_CALLBACK_FAILED`).
+ *
+ * E is what the lights deliver there through the occluders, the same way the cache's samples
+ * were lit: occluders closer than `shadow_skip` to the node should be ignored (they are the
+ * surface near the shading point curving up, not a shadow's edge; `docs/physics.md` §16).
+ * `position` and `normal` point to 3 floats each, valid during the call only; `normal` is the
+ * unit normal at the shading point (the nodes lie on its tangent disc, bent slightly towards
+ * it). `user` is the pointer given to `lucent_query_point_refined`.
+ *
+ * The callback is called on the thread that called `lucent_query_point_refined`, only
+ * during that call (threads querying at once call it at once). It must return normally: a C++ exception or a `longjmp` out of it is
+ * undefined behaviour (a Rust panic, in an `extern "C-unwind"` function, is caught and
+ * reported as `LUCENT_PANIC`).
+ */
+typedef int (*LucentIrradianceFn)(void *user,
+                                  const float *position,
+                                  const float *normal,
+                                  float shadow_skip,
+                                  float *irradiance);
 
 #ifdef __cplusplus
 extern "C" {
@@ -358,8 +394,8 @@ enum LucentStatus lucent_profile_radiance(const struct LucentProfile *profile,
 
 /**
  * Writes the `LucentMethod` named `name` to `*out`: `"hierarchical"`, `"local-global"`,
- * `"edge-aware"` or `"exhaustive"` (the scene format's names). `"edge-refined"` gives
- * `LUCENT_UNSUPPORTED`; any other name `LUCENT_INVALID_ARGUMENT`.
+ * `"edge-aware"`, `"exhaustive"` or `"edge-refined"` (the scene format's names); any other
+ * name gives `LUCENT_INVALID_ARGUMENT`.
  *
  * # Safety
  *
@@ -381,16 +417,16 @@ enum LucentStatus lucent_query_options_init(struct LucentQueryOptions *out);
 /**
  * Makes a query plan for `profile` with `options`: the smoothing radius is α =
  * `options->smoothing_factor`·√Ā with Ā the mean sample area of `cache` (see
- * `lucent_cache_smoothing_radius`), and for local-global and edge-aware the local integral K
- * of the profile for α is computed here (a few numerical quadratures: make one plan per
- * material and cache, not one per query). The plan copies what it needs: `profile` may be
- * freed afterwards, and the plan may query any cache (α stays what it was made with).
+ * `lucent_cache_smoothing_radius`), and for local-global, edge-aware and edge-refined the
+ * local integral K of the profile for α (and edge-refined's quadrature nodes) are computed
+ * here (a few numerical quadratures: make one plan per material and cache, not one per
+ * query). The plan copies what it needs: `profile` may be freed afterwards, and the plan may
+ * query any cache (α stays what it was made with).
  *
  * On success `*out` is a new plan to free with `lucent_query_free`; on failure `*out` is set
  * to NULL (when `out` is not NULL). Fails with `LUCENT_INVALID_ARGUMENT` for an unknown
- * method, a negative or non-finite option, or a zero α with local-global or edge-aware
- * (factor 0, or an empty cache); `LUCENT_UNSUPPORTED` for edge-refined (4);
- * `LUCENT_NULL_POINTER` for a NULL argument.
+ * method, a negative or non-finite option, or a zero α with local-global, edge-aware or
+ * edge-refined (factor 0, or an empty cache); `LUCENT_NULL_POINTER` for a NULL argument.
  *
  * # Safety
  *
@@ -436,8 +472,9 @@ enum LucentStatus lucent_query_local_integral(const struct LucentQuery *query, f
  * cache's samples and leaves it at `point`, through the plan's profile, by its method.
  *
  * Fails with `LUCENT_INVALID_ARGUMENT` for a non-finite position or a negative or
- * non-finite irradiance; `LUCENT_NULL_POINTER` for a NULL argument. `*out` is written only on
- * success.
+ * non-finite irradiance; `LUCENT_NULL_POINTER` for a NULL argument; `LUCENT_UNSUPPORTED` for
+ * an edge-refined plan (it needs the irradiance callback of `lucent_query_point_refined`).
+ * `*out` is written only on success.
  *
  * # Safety
  *
@@ -450,7 +487,8 @@ enum LucentStatus lucent_query_point(const struct LucentQuery *query,
                                      struct LucentExitance *out);
 
 /**
- * `lucent_query_point` for `count` points: `out[i]` is the exitance at `points[i]`. Either
+ * `lucent_query_point` for `count` points (not for an edge-refined plan): `out[i]` is the
+ * exitance at `points[i]`. Either
  * every query succeeds and all of `out` is written, or the call fails naming the first bad
  * point and `out` is left untouched. Runs on the calling thread; to use several cores, split
  * the points and call this from several threads with the same plan and cache. `points` and
@@ -466,6 +504,41 @@ enum LucentStatus lucent_query_points(const struct LucentQuery *query,
                                       const struct LucentShadingPoint *points,
                                       size_t count,
                                       struct LucentExitance *out);
+
+/**
+ * `lucent_query_point` with the caller's irradiance: any plan, and the only call for an
+ * edge-refined one. Where the edge-refined query finds the samples' irradiance within α not
+ * uniform, `callback` is called once per quadrature node (12 nodes) for E there, and the
+ * local term becomes K·(E(x) + Σ fᵢ·(E(x′ᵢ) − E(x))) with the profile's weights fᵢ
+ * (`docs/physics.md` §16); elsewhere, and for every other method, the result is that of
+ * `lucent_query_point` and `callback` is not called.
+ *
+ * `normal` is the unit surface normal at `point` (3 floats, length within 1e-3 of 1; it is
+ * renormalised). `seed` turns the node pattern about the normal: give neighbouring shading
+ * points different seeds (a pixel or sample index will do) so that the quadrature's angular
+ * error becomes fine noise instead of a pattern; the same seed gives the same nodes.
+ *
+ * Fails with `LUCENT_NULL_POINTER` for a NULL argument (`user` excepted, which is only
+ * passed on); `LUCENT_INVALID_ARGUMENT` for a bad point (as `lucent_query_point`), a normal
+ * that is not a finite unit vector, or a callback result that is not finite and
+ * non-negative (the message names the node); `LUCENT_CALLBACK_FAILED` when the callback
+ * returns non-zero. `*out` is written only on success.
+ *
+ * # Safety
+ *
+ * `query` and `cache` are NULL or live handles; `point` is NULL or points to a
+ * `LucentShadingPoint`; `normal` is NULL or points to 3 floats; `callback` is NULL or a
+ * function that honours `LucentIrradianceFn`'s contract for this `user`; `out` is NULL or
+ * valid for writing a `LucentExitance`.
+ */
+enum LucentStatus lucent_query_point_refined(const struct LucentQuery *query,
+                                             const struct LucentCache *cache,
+                                             const struct LucentShadingPoint *point,
+                                             const float *normal,
+                                             uint64_t seed,
+                                             LucentIrradianceFn callback,
+                                             void *user,
+                                             struct LucentExitance *out);
 
 /**
  * The message of the last failed `lucent_*` call on the calling thread, or "" if that call

@@ -5,8 +5,8 @@
 
 use lucent_core::glam::Vec3;
 use lucent_core::{
-    IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, QuerySettings, Sample,
-    ShadingPoint,
+    Exitance, IrradianceCache, LocalIntegralTable, LocalQuadrature, LocalTerm, Method, Profile,
+    QuerySettings, Sample, ShadingPoint,
 };
 
 use crate::status::{Failure, LucentStatus};
@@ -15,8 +15,8 @@ use crate::types::{
     LucentShadingPoint,
 };
 
-/// The edge-refined method's value in `LucentQueryOptions.method` (not offered).
-const EDGE_REFINED: u32 = 4;
+/// How far from 1 the length of a shading normal may be (`lucent_query_point_refined`).
+pub(crate) const NORMAL_TOLERANCE: f32 = 1e-3;
 
 /// A diffusion profile (the inside of a `LucentProfile` handle).
 #[derive(Clone, Debug)]
@@ -36,6 +36,21 @@ pub(crate) struct Plan {
     local: LocalTerm,
     /// α for the unsplit methods too (the core's `LocalTerm::NONE` has α = 0).
     smoothing_radius: f32,
+    /// The edge-refined method's nodes and weights for the profile and α (edge-refined only).
+    quadrature: Option<LocalQuadrature>,
+}
+
+/// The caller's irradiance at one quadrature node of the edge-refined local term: called with
+/// the node's index, position, the unit normal at the shading point and the shadow-skip
+/// distance; returns E per RGB channel (checked here) or the caller's failure.
+pub(crate) trait NodeIrradiance {
+    fn at(
+        &mut self,
+        node: usize,
+        position: [f32; 3],
+        normal: [f32; 3],
+        skip: f32,
+    ) -> Result<[f32; 3], Failure>;
 }
 
 fn invalid(error: impl std::fmt::Display) -> Failure {
@@ -135,8 +150,9 @@ impl Cache {
 }
 
 impl Plan {
-    /// Settings from the options, with α = k·√Ā of `cache` and, for local-global and
-    /// edge-aware, K for `material` and α (zero for the others).
+    /// Settings from the options, with α = k·√Ā of `cache` and, for local-global, edge-aware
+    /// and edge-refined, K for `material` and α (zero for the others), and edge-refined's
+    /// quadrature.
     pub(crate) fn new(
         material: &Material,
         cache: &Cache,
@@ -172,11 +188,20 @@ impl Plan {
             cull_tolerance: options.cull_tolerance,
         };
         settings.validate().map_err(invalid)?;
+        let quadrature = (method == Method::EdgeRefined).then(|| {
+            LocalQuadrature::new(
+                &material.0,
+                alpha,
+                LocalQuadrature::DEFAULT_RINGS,
+                LocalQuadrature::DEFAULT_PER_RING,
+            )
+        });
         Ok(Plan {
             profile: material.0,
             settings,
             local: local_integral,
             smoothing_radius: alpha,
+            quadrature,
         })
     }
 
@@ -190,26 +215,32 @@ impl Plan {
         self.local.k().to_array()
     }
 
-    /// One query.
+    /// The core's query at `point`, the local term unrefined.
+    fn query_core(&self, cache: &Cache, point: &LucentShadingPoint) -> Result<Exitance, Failure> {
+        let point = ShadingPoint {
+            position: Vec3::from_array(point.position),
+            irradiance: Vec3::from_array(point.irradiance),
+        };
+        cache
+            .0
+            .query(&self.profile, &point, self.local, &self.settings)
+            .map_err(invalid)
+    }
+
+    /// One query without a callback: every method but edge-refined.
     pub(crate) fn query(
         &self,
         cache: &Cache,
         point: &LucentShadingPoint,
     ) -> Result<LucentExitance, Failure> {
-        let point = ShadingPoint {
-            position: Vec3::from_array(point.position),
-            irradiance: Vec3::from_array(point.irradiance),
-        };
-        let m = cache
-            .0
-            .query(&self.profile, &point, self.local, &self.settings)
-            .map_err(invalid)?;
-        Ok(LucentExitance {
-            total: m.total.to_array(),
-            local: m.local.to_array(),
-            global: m.global.to_array(),
-            local_irradiance: m.local_irradiance.to_array(),
-        })
+        if self.quadrature.is_some() {
+            return Err(Failure::new(
+                LucentStatus::LUCENT_UNSUPPORTED,
+                "an edge-refined plan needs the caller's irradiance at quadrature nodes: \
+                 query it with lucent_query_point_refined",
+            ));
+        }
+        Ok(exitance(self.query_core(cache, point)?))
     }
 
     /// Many queries, all or nothing: the first failure names its point.
@@ -223,10 +254,78 @@ impl Plan {
             .enumerate()
             .map(|(i, point)| {
                 self.query(cache, point)
-                    .map_err(|f| Failure::invalid(format!("point {i}: {}", f.message)))
+                    .map_err(|f| Failure::new(f.status, format!("point {i}: {}", f.message)))
             })
             .collect()
     }
+
+    /// One query of any method, the edge-refined local term evaluated with the caller's
+    /// irradiance at the quadrature nodes where the core flags the point (`docs/physics.md`
+    /// §16). Node n lies at x + t₁·o.x + t₂·o.y + n·lift(n), (t₁, t₂) the normal's orthonormal
+    /// pair and o the node's offset with the pattern turned by a hash of `seed`: the steps of
+    /// the renderer's refinement, with the lights and occluders on the caller's side.
+    pub(crate) fn query_refined(
+        &self,
+        cache: &Cache,
+        point: &LucentShadingPoint,
+        normal: [f32; 3],
+        seed: u64,
+        irradiance: &mut impl NodeIrradiance,
+    ) -> Result<LucentExitance, Failure> {
+        let n = Vec3::from_array(normal);
+        let length = n.length();
+        if !(n.is_finite() && (length - 1.0).abs() <= NORMAL_TOLERANCE) {
+            return Err(Failure::invalid(format!(
+                "normal must be a finite unit vector (length within {NORMAL_TOLERANCE} of 1), \
+                 got {normal:?} of length {length}"
+            )));
+        }
+        let n = n / length;
+        let m = self.query_core(cache, point)?;
+        let (true, Some(quadrature)) = (m.refine, self.quadrature.as_ref()) else {
+            return Ok(exitance(m));
+        };
+        let x = Vec3::from_array(point.position);
+        let (t1, t2) = n.any_orthonormal_pair();
+        let rotation = LocalQuadrature::rotation(splitmix64(seed));
+        let skip = quadrature.shadow_skip();
+        let mut at = [Vec3::ZERO; LocalQuadrature::MAX_NODES];
+        for (node, e) in at.iter_mut().enumerate().take(quadrature.len()) {
+            let o = quadrature.offset(node, rotation);
+            let p = x + t1 * o.x + t2 * o.y + n * quadrature.lift(node);
+            let value = irradiance.at(node, p.to_array(), n.to_array(), skip)?;
+            if !value.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(Failure::invalid(format!(
+                    "the irradiance callback gave {value:?} at node {node} (position {:?}): \
+                     irradiance must be finite and non-negative",
+                    p.to_array()
+                )));
+            }
+            *e = Vec3::from_array(value);
+        }
+        let e_x = Vec3::from_array(point.irradiance);
+        let local = quadrature.local_term(e_x, self.local, &at[..quadrature.len()]);
+        Ok(exitance(m.with_local(local, self.local)))
+    }
+}
+
+/// The C struct of a core result.
+fn exitance(m: Exitance) -> LucentExitance {
+    LucentExitance {
+        total: m.total.to_array(),
+        local: m.local.to_array(),
+        global: m.global.to_array(),
+        local_irradiance: m.local_irradiance.to_array(),
+    }
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014): spreads a caller's seed, often a small index, over
+/// all 64 bits before [`LocalQuadrature::rotation`] reads its top 53.
+pub(crate) fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// The core's method for a `LucentMethod` value.
@@ -236,25 +335,17 @@ fn method(value: u32) -> Result<Method, Failure> {
         v if v == LucentMethod::LUCENT_METHOD_LOCAL_GLOBAL as u32 => Method::LocalGlobal,
         v if v == LucentMethod::LUCENT_METHOD_EDGE_AWARE as u32 => Method::EdgeAware,
         v if v == LucentMethod::LUCENT_METHOD_EXHAUSTIVE as u32 => Method::Exhaustive,
-        EDGE_REFINED => return Err(edge_refined_unsupported()),
+        v if v == LucentMethod::LUCENT_METHOD_EDGE_REFINED as u32 => Method::EdgeRefined,
         v => {
             return Err(Failure::invalid(format!(
-                "method {v} is not a LucentMethod (0 to 3)"
+                "method {v} is not a LucentMethod (0 to 4)"
             )));
         }
     })
 }
 
-fn edge_refined_unsupported() -> Failure {
-    Failure::new(
-        LucentStatus::LUCENT_UNSUPPORTED,
-        "the edge-refined method needs the caller's irradiance at quadrature points and is \
-         not offered through the C interface; use edge-aware",
-    )
-}
-
 /// The `LucentMethod` with this scene-format name (`hierarchical`, `local-global`,
-/// `edge-aware`, `exhaustive`).
+/// `edge-aware`, `exhaustive`, `edge-refined`).
 pub(crate) fn method_from_name(name: &str) -> Result<LucentMethod, Failure> {
     let found = Method::ALL
         .into_iter()
@@ -265,7 +356,7 @@ pub(crate) fn method_from_name(name: &str) -> Result<LucentMethod, Failure> {
         Method::LocalGlobal => LucentMethod::LUCENT_METHOD_LOCAL_GLOBAL,
         Method::EdgeAware => LucentMethod::LUCENT_METHOD_EDGE_AWARE,
         Method::Exhaustive => LucentMethod::LUCENT_METHOD_EXHAUSTIVE,
-        Method::EdgeRefined => return Err(edge_refined_unsupported()),
+        Method::EdgeRefined => LucentMethod::LUCENT_METHOD_EDGE_REFINED,
     })
 }
 

@@ -40,9 +40,9 @@ pub use profile::{
     lucent_profile_radiance, lucent_profile_total_reflectance,
 };
 pub use query::{
-    LucentQuery, lucent_method_from_name, lucent_query_free, lucent_query_local_integral,
-    lucent_query_new, lucent_query_options_init, lucent_query_point, lucent_query_points,
-    lucent_query_smoothing_radius,
+    LucentIrradianceFn, LucentQuery, lucent_method_from_name, lucent_query_free,
+    lucent_query_local_integral, lucent_query_new, lucent_query_options_init, lucent_query_point,
+    lucent_query_point_refined, lucent_query_points, lucent_query_smoothing_radius,
 };
 pub use status::{LucentStatus, lucent_last_error_message};
 pub use types::{

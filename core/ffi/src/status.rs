@@ -23,13 +23,16 @@ pub enum LucentStatus {
     LUCENT_INVALID_ARGUMENT = 2,
     /// `lucent_profile_from_preset` was given a name that is not a measured material.
     LUCENT_UNKNOWN_PRESET = 3,
-    /// A valid request that the C interface does not offer: the edge-refined method, whose
-    /// local term is a quadrature of irradiance the caller evaluates at points the query
-    /// chooses (use edge-aware, or lucent-core from Rust).
+    /// A valid request that the call cannot serve: an edge-refined plan given to
+    /// `lucent_query_point` or `lucent_query_points`, which have no irradiance callback (use
+    /// `lucent_query_point_refined`).
     LUCENT_UNSUPPORTED = 4,
     /// An internal error (a panic inside the library) was caught at the boundary. The library
     /// state is unchanged (handles stay valid), but this is a bug: please report the message.
     LUCENT_PANIC = 5,
+    /// The caller's irradiance callback returned non-zero: the query was abandoned and nothing
+    /// was written (the message names the node and the value returned).
+    LUCENT_CALLBACK_FAILED = 6,
 }
 
 /// A failed call: its status and a message for `lucent_last_error_message`.

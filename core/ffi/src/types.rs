@@ -33,7 +33,8 @@ pub struct LucentShadingPoint {
     /// Position x (scene units), finite.
     pub position: [f32; 3],
     /// Irradiance E(x) at x itself per RGB channel, finite and ≥ 0 (the local-global
-    /// method's local term is E(x)·K; edge-aware weighs it in; the others ignore it).
+    /// method's local term is E(x)·K; edge-aware and edge-refined weigh it in; the others
+    /// ignore it).
     pub irradiance: [f32; 3],
 }
 
@@ -53,7 +54,8 @@ pub struct LucentExitance {
     /// The octree (or exhaustive) sum.
     pub global: [f32; 3],
     /// The irradiance that drives the local term: E(x) for local-global, the kernel-weighted
-    /// E_loc for edge-aware, zero for the others.
+    /// E_loc for edge-aware (and edge-refined where it is not refined), local / K where
+    /// edge-refined refines it, zero for the others.
     pub local_irradiance: [f32; 3],
 }
 
@@ -69,9 +71,7 @@ pub struct LucentCoefficients {
     pub eta: f32,
 }
 
-/// Which sum a query evaluates (`LucentQueryOptions.method`). The value 4 is the
-/// edge-refined method, which needs irradiance evaluated by the caller at quadrature points the
-/// query picks; the C interface does not offer it and answers `LUCENT_UNSUPPORTED`.
+/// Which sum a query evaluates (`LucentQueryOptions.method`).
 #[repr(C)]
 #[allow(non_camel_case_types)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,6 +85,11 @@ pub enum LucentMethod {
     LUCENT_METHOD_EDGE_AWARE = 2,
     /// Every sample, no approximation: the reference, and slow.
     LUCENT_METHOD_EXHAUSTIVE = 3,
+    /// Edge-aware, except where the samples' irradiance within α is not uniform (a shadow
+    /// edge): there the local term is a quadrature of the irradiance that the caller
+    /// evaluates at nodes around x (`docs/physics.md` §16). Queried only with
+    /// `lucent_query_point_refined`, which takes the callback.
+    LUCENT_METHOD_EDGE_REFINED = 4,
 }
 
 /// How to query: the input of `lucent_query_new`. `lucent_query_options_init` fills in the
@@ -94,7 +99,7 @@ pub enum LucentMethod {
 pub struct LucentQueryOptions {
     /// A `LucentMethod` value.
     pub method: u32,
-    /// k in the smoothing radius α = k·√Ā of local-global and edge-aware (Ā the cache's mean
+    /// k in the smoothing radius α = k·√Ā of the split methods (Ā the cache's mean
     /// sample area; N10 suggests 1 to 4), finite and ≥ 0. Ignored by the other methods.
     pub smoothing_factor: f32,
     /// JB02's solid-angle threshold ε: a node is aggregated when A/|x − P|² < ε (0 = never).

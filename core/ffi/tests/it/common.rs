@@ -182,7 +182,7 @@ pub fn rel_err(a: [f32; 3], b: [f32; 3]) -> f32 {
         .fold(0.0, f32::max)
 }
 
-/// Every method the C interface offers.
+/// Every method `lucent_query_point` offers (edge-refined needs `lucent_query_point_refined`).
 pub const METHODS: [LucentMethod; 4] = [
     LucentMethod::LUCENT_METHOD_HIERARCHICAL,
     LucentMethod::LUCENT_METHOD_LOCAL_GLOBAL,

@@ -252,7 +252,7 @@ fn out_of_range_numbers_name_the_argument() {
             options(2, 0.0),
             "the edge-aware method needs a positive smoothing radius",
         ),
-        (options(9, 2.0), "method 9 is not a LucentMethod (0 to 3)"),
+        (options(9, 2.0), "method 9 is not a LucentMethod (0 to 4)"),
         (
             LucentQueryOptions {
                 epsilon: -0.1,
@@ -305,7 +305,7 @@ fn out_of_range_numbers_name_the_argument() {
 }
 
 #[test]
-fn unknown_and_unsupported_names_have_their_own_statuses() {
+fn unknown_names_and_unsupported_calls_have_their_own_statuses() {
     assert_eq!(preset("granite", 1.0).err(), Some(LUCENT_UNKNOWN_PRESET));
     assert_eq!(message(), "unknown material preset \"granite\"");
 
@@ -317,34 +317,49 @@ fn unknown_and_unsupported_names_have_their_own_statuses() {
     assert!(out.is_null());
 
     let mut method = LucentMethod::LUCENT_METHOD_HIERARCHICAL;
-    for (name, want, says) in [
-        (
-            "edge-refined",
-            LUCENT_UNSUPPORTED,
-            "edge-refined method needs the caller's irradiance",
-        ),
-        (
-            "Edge-Aware",
-            LUCENT_INVALID_ARGUMENT,
-            "unknown method \"Edge-Aware\"",
-        ),
-    ] {
-        let name = CString::new(name).unwrap();
-        // SAFETY: a NUL-terminated name and a writable LucentMethod.
-        let status = unsafe { lucent_method_from_name(name.as_ptr(), &mut method) };
-        fails(status, want, says);
-    }
+    let name = CString::new("Edge-Aware").unwrap();
+    // SAFETY: a NUL-terminated name and a writable LucentMethod.
+    let status = unsafe { lucent_method_from_name(name.as_ptr(), &mut method) };
+    fails(
+        status,
+        LUCENT_INVALID_ARGUMENT,
+        "unknown method \"Edge-Aware\"",
+    );
     assert_eq!(
         method,
         LucentMethod::LUCENT_METHOD_HIERARCHICAL,
         "failures write nothing"
     );
+    let name = CString::new("edge-refined").unwrap();
+    // SAFETY: a NUL-terminated name and a writable LucentMethod.
+    let status = unsafe { lucent_method_from_name(name.as_ptr(), &mut method) };
+    assert_eq!(status, LucentStatus::LUCENT_OK);
+    assert_eq!(method, LucentMethod::LUCENT_METHOD_EDGE_REFINED);
 
-    // The edge-refined value itself.
+    // An edge-refined plan is made, but only the call with a callback queries it.
     let skin = preset("skin1", 1.0).unwrap();
     let cache = build(&patch(1.0, 0.25, [1.0; 3])).unwrap();
-    assert_eq!(plan(&skin, &cache, 4, 2.0).err(), Some(LUCENT_UNSUPPORTED));
-    assert!(message().contains("use edge-aware"), "{}", message());
+    let q = plan(&skin, &cache, method as u32, 2.0).unwrap();
+    let point = LucentShadingPoint {
+        position: [0.0; 3],
+        irradiance: [1.0; 3],
+    };
+    assert_eq!(query(&q, &cache, &point).err(), Some(LUCENT_UNSUPPORTED));
+    assert!(
+        message().contains("query it with lucent_query_point_refined"),
+        "{}",
+        message()
+    );
+    let mut out = [LucentExitance::default(); 2];
+    let points = [point; 2];
+    // SAFETY: live handles, two readable points and two writable results.
+    let status = unsafe { lucent_query_points(q.0, cache.0, points.as_ptr(), 2, out.as_mut_ptr()) };
+    fails(status, LUCENT_UNSUPPORTED, "point 0: an edge-refined plan");
+    assert_eq!(
+        out,
+        [LucentExitance::default(); 2],
+        "failures write nothing"
+    );
 }
 
 #[test]

@@ -9,3 +9,4 @@ mod errors;
 mod header;
 mod profile;
 mod query;
+mod refined;
