@@ -23,6 +23,25 @@ fn fails(status: LucentStatus, want: LucentStatus, says: &str) {
     );
 }
 
+type Callback = unsafe extern "C-unwind" fn(
+    *mut std::ffi::c_void,
+    *const f32,
+    *const f32,
+    f32,
+    *mut f32,
+) -> std::ffi::c_int;
+
+/// An irradiance callback for calls that fail before any node is evaluated.
+unsafe extern "C-unwind" fn never_called(
+    _: *mut std::ffi::c_void,
+    _: *const f32,
+    _: *const f32,
+    _: f32,
+    _: *mut f32,
+) -> std::ffi::c_int {
+    unreachable!("a call with a NULL argument evaluates nothing")
+}
+
 #[test]
 fn every_pointer_argument_is_checked_for_null() {
     let skin = preset("skin1", 1.0).unwrap();
@@ -164,6 +183,16 @@ fn every_pointer_argument_is_checked_for_null() {
             lucent_query_points(qp, k, &point, 1, null_mut()),
             "out is NULL",
         );
+        let (z, cb) = ([0.0f32, 0.0, 1.0].as_ptr(), Some(never_called as Callback));
+        let refined = |q, k, point, normal, cb, out| {
+            lucent_query_point_refined(q, k, point, normal, 0, cb, null_mut(), out)
+        };
+        check(refined(null(), k, &point, z, cb, &mut m), "query is NULL");
+        check(refined(qp, null(), &point, z, cb, &mut m), "cache is NULL");
+        check(refined(qp, k, null(), z, cb, &mut m), "point is NULL");
+        check(refined(qp, k, &point, null(), cb, &mut m), "normal is NULL");
+        check(refined(qp, k, &point, z, None, &mut m), "callback is NULL");
+        check(refined(qp, k, &point, z, cb, null_mut()), "out is NULL");
     }
     assert!(profile_out.is_null() && cache_out.is_null() && query_out.is_null());
     // Zero-length batches accept NULL arrays.

@@ -622,3 +622,52 @@ fn a_panicking_callback_is_caught_at_the_boundary() {
     .unwrap();
     assert_eq!(message(), "");
 }
+
+#[test]
+fn threads_share_one_plan_and_cache_with_their_own_callbacks() {
+    // Points along y next to the edge, each with its own seed, serially and on 4 threads.
+    let (skin, cache) = scene(true);
+    let q = plan(&skin, &cache, EDGE_REFINED, 2.0).unwrap();
+    let points: Vec<(LucentShadingPoint, u64)> = (0..32)
+        .map(|i| (lit([0.3, i as f32 * 0.25 - 4.0, 0.0]), i))
+        .collect();
+    // SAFETY: both handles are live until the end of this test, after the threads joined.
+    let (shared_plan, shared_cache) = unsafe { (&*q.0, &*cache.0) };
+    let one = |(point, seed): &(LucentShadingPoint, u64)| {
+        let mut lighting = Lighting {
+            half_plane: true,
+            ..Lighting::default()
+        };
+        let mut out = LucentExitance::default();
+        // SAFETY: live handles (borrowed for the test), a live point, 3 readable floats, the
+        // test callback with this thread's own `Lighting`, and a writable result.
+        let status = unsafe {
+            lucent_query_point_refined(
+                shared_plan,
+                shared_cache,
+                point,
+                [0.0f32, 0.0, 1.0].as_ptr(),
+                *seed,
+                Some(irradiance),
+                std::ptr::from_mut(&mut lighting).cast(),
+                &mut out,
+            )
+        };
+        assert_eq!(status, LUCENT_OK);
+        assert_eq!(lighting.calls.len(), 12);
+        out
+    };
+    let serial: Vec<LucentExitance> = points.iter().map(one).collect();
+    let parallel: Vec<LucentExitance> = std::thread::scope(|scope| {
+        let one = &one;
+        let quarters: Vec<_> = points
+            .chunks(8)
+            .map(|chunk| scope.spawn(move || chunk.iter().map(one).collect::<Vec<_>>()))
+            .collect();
+        quarters
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect()
+    });
+    assert_eq!(serial, parallel);
+}
