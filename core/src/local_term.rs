@@ -12,7 +12,7 @@ use glam::Vec3;
 
 use crate::error::ParamError;
 use crate::profile::Profile;
-use crate::table::{check_smoothing_radius, exact_local_integral};
+use crate::table::exact_local_integral;
 
 /// The smoothing radius α (scene units) and the local integral K per RGB channel for it.
 ///
@@ -51,7 +51,18 @@ impl LocalTerm {
     /// rounding to f32): for a material that does not vary over the surface, computed once
     /// per object. Errors if α is not finite and positive.
     pub fn exact(profile: &Profile, alpha: f32) -> Result<LocalTerm, ParamError> {
-        check_smoothing_radius(alpha)?;
+        if !alpha.is_finite() {
+            return Err(ParamError::NotFinite {
+                name: "smoothing radius",
+                value: alpha,
+            });
+        }
+        if alpha <= 0.0 {
+            return Err(ParamError::NotPositive {
+                name: "smoothing radius",
+                value: alpha,
+            });
+        }
         Ok(LocalTerm::new(alpha, exact_local_integral(profile, alpha)))
     }
 

@@ -269,7 +269,18 @@ impl LocalIntegralTable {
     /// varies), smoothing radius `alpha` (scene units), and threshold `ell_min` (scene units;
     /// below it the ℓ → 0 limit Rd_total is used). Nothing is computed yet.
     pub fn new(profile: &Profile, alpha: f32, ell_min: f32) -> Result<Self, ParamError> {
-        check_smoothing_radius(alpha)?;
+        if !alpha.is_finite() {
+            return Err(ParamError::NotFinite {
+                name: "smoothing radius",
+                value: alpha,
+            });
+        }
+        if alpha <= 0.0 {
+            return Err(ParamError::NotPositive {
+                name: "smoothing radius",
+                value: alpha,
+            });
+        }
         if !ell_min.is_finite() {
             return Err(ParamError::NotFinite {
                 name: "ell_min",
@@ -508,23 +519,6 @@ impl LocalIntegralTable {
             .filter(move |&i| filled(i) || (i > 0 && filled(i - 1)))
             .map(move |i| self.k_lo + i as i32)
     }
-}
-
-/// A smoothing radius α must be finite and positive.
-pub(crate) fn check_smoothing_radius(alpha: f32) -> Result<(), ParamError> {
-    if !alpha.is_finite() {
-        return Err(ParamError::NotFinite {
-            name: "smoothing radius",
-            value: alpha,
-        });
-    }
-    if alpha <= 0.0 {
-        return Err(ParamError::NotPositive {
-            name: "smoothing radius",
-            value: alpha,
-        });
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -45,10 +45,7 @@
 //! of a face). See "Known limitations" in `docs/fuzzing.md`.
 //!
 //! And, for a built-in closed shape: when an edit removed a solid face, the mesh must not be
-//! accepted unless it is flat by the test above (a hole means not closed) — or unless its
-//! solid faces still close up on their own, which happens when rounding collapsed the removed
-//! face's neighbours to zero area (checked by brute force: every edge of a solid face shared by
-//! exactly two of them).
+//! accepted unless it is flat by the test above (a hole means not closed).
 
 use std::f64::consts::TAU;
 
@@ -185,41 +182,6 @@ fn solid(t: [Vec3; 3], diag: f64) -> Option<Plane> {
     })
 }
 
-/// True if the solid faces of `mesh` form a closed surface on their own: with corners closer
-/// than `WELD` of the diagonal taken as one vertex (pairwise, brute force), every edge of a
-/// solid face is an edge of exactly two of them. A removed face normally leaves its
-/// neighbours' edges with one face each; but where rounding collapsed its neighbours to zero
-/// area, the solid faces left can close up without it (a cuboid moved to 2·10¹⁰ whose f32
-/// corners merge into a tetrahedron: `crash-cuboid-rounded-into-a-closed-tetrahedron`), and then
-/// the mesh is closed and may be accepted.
-fn solid_faces_close_up(mesh: &Mesh, diag: f64) -> bool {
-    let weld = WELD * diag;
-    let n = mesh.positions.len();
-    let mut id: Vec<usize> = (0..n).collect();
-    for i in 0..n {
-        for j in 0..i {
-            let (a, b) = (mesh.positions[i].as_dvec3(), mesh.positions[j].as_dvec3());
-            if a.distance(b) <= weld {
-                id[i] = id[j];
-                break;
-            }
-        }
-    }
-    let mut edges: std::collections::HashMap<(usize, usize), u32> = Default::default();
-    for t in &mesh.triangles {
-        let p = t.map(|i| mesh.positions[i as usize]);
-        if solid(p, diag).is_none() {
-            continue;
-        }
-        let v = t.map(|i| id[i as usize]);
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    !edges.is_empty() && edges.values().all(|&c| c == 2)
-}
-
 /// The exhaustive check: how far from flat and from convex the mesh is, relative to the
 /// diagonal: the smallest over solid faces of the largest |distance| of a corner from its plane,
 /// and the largest distance of a corner in front of a solid face's plane (see the module docs).
@@ -295,7 +257,7 @@ pub fn convexity_is_sound(data: &[u8]) {
         "accepted a mesh that is neither flat ({off_flat:e} of the diagonal off its flattest \
          face's plane) nor convex ({off_convex:e} in front of a face): {mesh:?}"
     );
-    if removed.iter().any(|&t| solid(t, diag).is_some()) && !solid_faces_close_up(&mesh, diag) {
+    if removed.iter().any(|&t| solid(t, diag).is_some()) {
         assert!(
             flat,
             "accepted a closed shape with a solid face removed, not flat ({off_flat:e}): {mesh:?}"
@@ -306,21 +268,6 @@ pub fn convexity_is_sound(data: &[u8]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_hole_opens_the_solid_faces_unless_they_close_up_without_it() {
-        let mut cuboid = shapes::cuboid(Vec3::ONE);
-        let diag = diagonal(&cuboid.positions);
-        assert!(solid_faces_close_up(&cuboid, diag));
-        cuboid.triangles.remove(3);
-        assert!(!solid_faces_close_up(&cuboid, diag));
-        assert!(!solid_faces_close_up(
-            &shapes::plane(Vec2::ONE),
-            2f64.sqrt()
-        ));
-        let sphere = shapes::sphere(1.0, 8);
-        assert!(solid_faces_close_up(&sphere, diagonal(&sphere.positions)));
-    }
 
     #[test]
     fn the_exhaustive_check_tells_convex_from_dented() {
