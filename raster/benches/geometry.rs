@@ -185,3 +185,52 @@ fn poisson(bencher: Bencher, n: u32) {
         .counter(ItemsCount::new(n))
         .bench(|| poisson_samples(black_box(&tris), SampleTarget::Count(n), 1));
 }
+
+/// A tessellated unit cube turned off the axes (`n`×`n` quads a side, outward faces, each
+/// triangle with its own corners): convex, but the boxes of its coplanar vertices straddle
+/// every face's plane, so the convexity test's work grows like V·F until its cap.
+fn tessellated_cube(n: u32) -> Mesh {
+    let turn = glam::Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 1.1);
+    let mut positions = Vec::new();
+    for axis in 0..3 {
+        for side in [-0.5f32, 0.5] {
+            let (mut u, mut v) = (Vec3::ZERO, Vec3::ZERO);
+            u[(axis + 1) % 3] = 1.0;
+            v[(axis + 2) % 3] = 1.0;
+            let mut normal = Vec3::ZERO;
+            normal[axis] = side;
+            let (u, v) = if side > 0.0 { (u, v) } else { (v, u) };
+            let corner = normal - (u + v) * 0.5;
+            positions.extend(grid(corner, u, v, n, n).into_iter().flatten());
+        }
+    }
+    let positions: Vec<Vec3> = positions.into_iter().map(|p| turn * p).collect();
+    Mesh {
+        normals: vec![Vec3::Z; positions.len()],
+        triangles: (0..positions.len() as u32 / 3)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect(),
+        positions,
+        uvs: None,
+    }
+}
+
+/// `cannot_shadow_itself` on a convex sphere (16k and 262k triangles, accepted), the default
+/// scene's bunny outline stand-in (a sphere with one face flipped: rejected at once), and a
+/// turned tessellated cube (the worst case, 24k triangles).
+#[divan::bench(args = ["sphere-128", "sphere-512", "flipped-face", "turned-cube-32"], sample_count = 5)]
+fn convexity(bencher: Bencher, which: &str) {
+    let mesh = match which {
+        "sphere-128" => sphere(1.0, 128),
+        "sphere-512" => sphere(1.0, 512),
+        "flipped-face" => {
+            let mut m = sphere(1.0, 128);
+            m.triangles[5000].swap(1, 2);
+            m
+        }
+        _ => tessellated_cube(32),
+    };
+    bencher
+        .counter(ItemsCount::new(mesh.triangles.len()))
+        .bench(|| lucent_raster::render::cannot_shadow_itself(black_box(&mesh)));
+}

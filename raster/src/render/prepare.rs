@@ -130,8 +130,8 @@ impl<'s> Prepared<'s> {
     }
 }
 
-/// Whether any triangle can shadow another point of the scene. A single closed convex or
-/// flat mesh cannot (its back faces receive no light anyway, by the cosine); anything else is
+/// Whether any triangle can shadow another point of the scene. A single mesh behind all its
+/// faces' planes (convex or flat) cannot (its back faces receive no light anyway, by the cosine); anything else is
 /// assumed to.
 pub fn can_occlude(objects: &[Object]) -> bool {
     match objects {
