@@ -89,6 +89,7 @@ mod profile;
 mod quadrature;
 mod query;
 mod refine;
+mod seed;
 pub mod stats;
 mod table;
 
@@ -129,6 +130,7 @@ pub mod internals {
     pub use crate::refine::{
         DEFAULT_PER_RING, DEFAULT_RINGS, EDGE_THRESHOLD, MAX_NODES, MAX_PER_RING, MAX_RINGS,
     };
+    pub use crate::seed::splitmix64;
     pub use crate::table::{
         exact_local_integral, local_integral_and_slope_unit, local_integral_slope_unit,
         local_integral_unit,

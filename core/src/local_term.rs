@@ -51,18 +51,7 @@ impl LocalTerm {
     /// rounding to f32): for a material that does not vary over the surface, computed once
     /// per object. Errors if α is not finite and positive.
     pub fn exact(profile: &Profile, alpha: f32) -> Result<LocalTerm, ParamError> {
-        if !alpha.is_finite() {
-            return Err(ParamError::NotFinite {
-                name: "smoothing radius",
-                value: alpha,
-            });
-        }
-        if alpha <= 0.0 {
-            return Err(ParamError::NotPositive {
-                name: "smoothing radius",
-                value: alpha,
-            });
-        }
+        check_smoothing_radius(alpha)?;
         Ok(LocalTerm::new(alpha, exact_local_integral(profile, alpha)))
     }
 
@@ -75,6 +64,23 @@ impl LocalTerm {
     pub fn k(self) -> Vec3 {
         self.k
     }
+}
+
+/// The smoothing radius α must be finite and positive (every K is for one α > 0).
+pub(crate) fn check_smoothing_radius(alpha: f32) -> Result<(), ParamError> {
+    if !alpha.is_finite() {
+        return Err(ParamError::NotFinite {
+            name: "smoothing radius",
+            value: alpha,
+        });
+    }
+    if alpha <= 0.0 {
+        return Err(ParamError::NotPositive {
+            name: "smoothing radius",
+            value: alpha,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

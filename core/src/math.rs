@@ -73,6 +73,12 @@ pub fn cos64(x: f64) -> f64 {
     libm::cos(x)
 }
 
+/// Arc cosine in double precision (libm), in [0, π].
+#[inline]
+pub fn acos64(x: f64) -> f64 {
+    libm::acos(x)
+}
+
 /// 2^k for an integer k in the normal range [−126, 127] (exact; built from the exponent bits).
 #[inline]
 pub fn pow2i(k: i32) -> f32 {

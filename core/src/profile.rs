@@ -9,6 +9,7 @@ use crate::dipole::{self, Dipole, NodeMoments};
 use crate::error::ParamError;
 use crate::fresnel;
 use crate::lanes::Lanes;
+use crate::math;
 use crate::presets::Preset;
 
 /// K_d is clamped into [`KD_MIN`, `KD_MAX`] before inversion, so that α′ stays representable
@@ -113,7 +114,7 @@ impl Profile {
                 Distance::DiffuseMeanFreePath(l) => {
                     check_distance("diffuse_mean_free_path", l[c])?;
                     let sigma_tr = 1.0 / l[c] as f64;
-                    sigma_tr / libm::sqrt(3.0 * (1.0 - albedo))
+                    sigma_tr / math::sqrt64(3.0 * (1.0 - albedo))
                 }
             };
             *slot = Some(Dipole::from_albedo_and_extinction(albedo, sigma_t, eta)?);

@@ -138,7 +138,7 @@ impl LocalQuadrature {
         let cdf = RadialCdf::new(profile, alpha);
         let mut fraction = [Vec3::ZERO; MAX_RINGS];
         let mut offset = [Vec2::ZERO; MAX_NODES];
-        let golden = (libm::sqrt(5.0) - 1.0) / 2.0;
+        let golden = (math::sqrt64(5.0) - 1.0) / 2.0;
         for j in 0..rings {
             let lo = cdf.at_reference_mass(j as f64 / rings as f64);
             let hi = cdf.at_reference_mass((j + 1) as f64 / rings as f64);
@@ -217,6 +217,12 @@ impl LocalQuadrature {
         Vec2::new(c as f32, s as f32)
     }
 
+    /// [`LocalQuadrature::rotation`] of a seed that need not be well mixed (a pixel index, a
+    /// sample number): the seed is spread over 64 bits by SplitMix64 first.
+    pub fn rotation_for_seed(seed: u64) -> Vec2 {
+        Self::rotation(crate::seed::splitmix64(seed))
+    }
+
     /// The local term K·(E(x) + Σ fᵢ·(E(x′ᵢ) − E(x))) from the irradiance `at_nodes` (node
     /// order; missing nodes count as E(x)), K that of `term` (the query's, for this
     /// quadrature's α). Equal to E(x)·K exactly where every node sees E(x).
@@ -240,7 +246,7 @@ struct RadialCdf {
 impl RadialCdf {
     fn new(profile: &Profile, alpha: f32) -> Self {
         // 2-point Gauss–Legendre nodes on [0, 1].
-        let g = 0.5 / libm::sqrt(3.0);
+        let g = 0.5 / math::sqrt64(3.0);
         let mut mass = [[0.0; INTERVALS + 1]; 3];
         let h = 1.0 / INTERVALS as f64;
         for m in 0..INTERVALS {
@@ -423,7 +429,7 @@ mod tests {
                         let ang = if r <= dd.abs() {
                             0.0
                         } else {
-                            libm::acos(dd.abs() / r)
+                            math::acos64(dd.abs() / r)
                         };
                         2.0 * r * ang * Kernel::weight_unit(r / a) * dip.rd(r / ell) / (ell * ell)
                     });

@@ -269,18 +269,7 @@ impl LocalIntegralTable {
     /// varies), smoothing radius `alpha` (scene units), and threshold `ell_min` (scene units;
     /// below it the ℓ → 0 limit Rd_total is used). Nothing is computed yet.
     pub fn new(profile: &Profile, alpha: f32, ell_min: f32) -> Result<Self, ParamError> {
-        if !alpha.is_finite() {
-            return Err(ParamError::NotFinite {
-                name: "smoothing radius",
-                value: alpha,
-            });
-        }
-        if alpha <= 0.0 {
-            return Err(ParamError::NotPositive {
-                name: "smoothing radius",
-                value: alpha,
-            });
-        }
+        crate::local_term::check_smoothing_radius(alpha)?;
         if !ell_min.is_finite() {
             return Err(ParamError::NotFinite {
                 name: "ell_min",

@@ -287,7 +287,7 @@ impl Plan {
         };
         let x = Vec3::from_array(point.position);
         let (t1, t2) = n.any_orthonormal_pair();
-        let rotation = LocalQuadrature::rotation(splitmix64(seed));
+        let rotation = LocalQuadrature::rotation_for_seed(seed);
         let skip = quadrature.shadow_skip();
         let mut at = [Vec3::ZERO; LocalQuadrature::MAX_NODES];
         for (node, e) in at.iter_mut().enumerate().take(quadrature.len()) {
@@ -317,15 +317,6 @@ fn exitance(m: Exitance) -> LucentExitance {
         global: m.global.to_array(),
         local_irradiance: m.local_irradiance.to_array(),
     }
-}
-
-/// SplitMix64 (Steele, Lea & Flood 2014): spreads a caller's seed, often a small index, over
-/// all 64 bits before [`LocalQuadrature::rotation`] reads its top 53.
-pub(crate) fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// The core's method for a `LucentMethod` value.

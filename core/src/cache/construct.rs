@@ -23,6 +23,7 @@ use super::{
 };
 use crate::error::BuildError;
 use crate::lanes::LANES;
+use crate::math;
 use crate::morton::Grid;
 
 /// A node while it is being split: its sample range, its first child and child count.
@@ -392,7 +393,7 @@ fn spread(s: &Samples, range: Range<usize>, sums: &Sums, centre: DVec3) -> ([f32
     } else {
         [0.0; 6]
     };
-    let r = libm::sqrt(r2).min(f32::MAX as f64);
+    let r = math::sqrt64(r2).min(f32::MAX as f64);
     let rounded = r as f32;
     let radius = if (rounded as f64) < r {
         rounded.next_up()

@@ -9,6 +9,7 @@ use core::fmt;
 
 use super::{COUNT_MASK, IrradianceCache, LEAF_BIT, LEAF_CAPACITY, MAX_DEPTH};
 use crate::lanes::LANES;
+use crate::math;
 
 /// A broken invariant, described.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -258,7 +259,7 @@ impl IrradianceCache {
                 (d.cov_yz[i] as f64, yy, zz),
             ] {
                 ensure!(
-                    c.abs() <= libm::sqrt(p * q) + slack,
+                    c.abs() <= math::sqrt64(p * q) + slack,
                     "node {i}: covariance {c} exceeds √({p}·{q})"
                 );
             }

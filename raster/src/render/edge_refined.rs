@@ -53,7 +53,7 @@ pub fn refine(
     m: Exitance,
 ) -> Exitance {
     let (t1, t2) = point.normal.any_orthonormal_pair();
-    let rotation = LocalQuadrature::rotation(splitmix64(point.seed ^ 0x005E_ED0F_ED6E));
+    let rotation = LocalQuadrature::rotation_for_seed(point.seed ^ 0x005E_ED0F_ED6E);
     // Occluders within α/2 of a node are the surface near x curving up, not a shadow's edge.
     let lighting = lighting.skipping(quadrature.shadow_skip());
     let mut at = [Vec3::ZERO; lucent_core::LocalQuadrature::MAX_NODES];
@@ -155,7 +155,7 @@ mod tests {
             let r = refine(&lighting, &q, &point, &mut ShadowHints::default(), m);
             assert_eq!(r.local, e * k, "seed {seed}");
             // Without the skip, the nodes under the wall would be dark.
-            let rotation = LocalQuadrature::rotation(splitmix64(seed ^ 0x005E_ED0F_ED6E));
+            let rotation = LocalQuadrature::rotation_for_seed(seed ^ 0x005E_ED0F_ED6E);
             for n in 0..q.len() {
                 let o = q.offset(n, rotation);
                 let p = Vec3::new(o.x, o.y, q.lift(n));

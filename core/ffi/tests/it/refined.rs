@@ -152,14 +152,6 @@ fn lit(position: [f32; 3]) -> LucentShadingPoint {
     }
 }
 
-/// SplitMix64, the seed hash the library documents for the pattern's rotation.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// The edge-refined query done by hand with lucent-core's Rust API, as the renderer does it:
 /// the core's query, then (if flagged) the quadrature of `light` at the nodes. Returns the
 /// result, whether it was refined, and the nodes.
@@ -204,7 +196,7 @@ fn by_hand(
         LocalQuadrature::DEFAULT_PER_RING,
     );
     let (t1, t2) = Vec3::Z.any_orthonormal_pair();
-    let rotation = LocalQuadrature::rotation(splitmix64(seed));
+    let rotation = LocalQuadrature::rotation_for_seed(seed);
     let nodes: Vec<Vec3> = (0..quadrature.len())
         .map(|n| {
             let o = quadrature.offset(n, rotation);
