@@ -81,7 +81,7 @@ impl fmt::Display for ParamError {
             }
             ParamError::OutOfRange { name, value } => write!(
                 f,
-                "{name} = {value} is outside the range the dipole can represent in single precision"
+                "{name} = {value:e} is outside the range the dipole can represent in single precision"
             ),
             ParamError::UnknownPreset => write!(f, "unknown material preset"),
         }

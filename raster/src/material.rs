@@ -122,7 +122,7 @@ impl Shader {
 
 /// How the translucent parameters vary over the surface.
 #[derive(Debug)]
-enum Params {
+pub(crate) enum Params {
     /// The same profile everywhere.
     Fixed(Profile),
     /// K_d and a distance, either of which may be a texture.
@@ -134,13 +134,13 @@ enum Params {
 }
 
 #[derive(Debug)]
-enum KdSource {
+pub(crate) enum KdSource {
     Constant([f64; 3]),
     Texture(Arc<Texture>, AlbedoInverter),
 }
 
 /// Validates every constant and both ends of every texture range by building profiles there.
-fn reflectance_params(
+pub(crate) fn reflectance_params(
     kd: &ColorParam,
     distance: &Distance,
     eta: f32,

@@ -786,6 +786,7 @@ fn end_to_end(out: &Path, threads: Option<usize>) -> Result<Duration, BenchError
     write_exr(
         &dir.join("lucent.exr"),
         &r.image,
+        Some(&r.alpha()),
         &r.layers(&scene.output.layers),
     )?;
     Ok(start.elapsed())

@@ -159,11 +159,11 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
         )?;
         scene.render.exposure = x;
     }
-    if let Some(p) = &args.output {
-        scene.output.png = Some(p.clone());
-    }
-    if let Some(p) = &args.exr {
-        scene.output.exr = Some(p.clone());
+    // Output paths on the command line replace the scene's, both of them: `-o x.png` alone
+    // used to write x.png and still overwrite the scene's EXR.
+    if args.output.is_some() || args.exr.is_some() {
+        scene.output.png = args.output.clone();
+        scene.output.exr = args.exr.clone();
     }
     Ok(())
 }
@@ -207,6 +207,7 @@ fn seconds(d: std::time::Duration) -> String {
 
 /// `lucent render`.
 pub fn render(args: &RenderArgs) -> Result<(), String> {
+    let start = std::time::Instant::now();
     let mut scene = load(args.scene.as_deref())?;
     apply(args, &mut scene)?;
     let outputs: Vec<&Path> = [&scene.output.png, &scene.output.exr]
@@ -236,8 +237,13 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         written.push(png.display().to_string());
     }
     if let Some(exr) = &scene.output.exr {
-        write_exr(exr, &result.image, &result.layers(&scene.output.layers))
-            .map_err(|e| e.to_string())?;
+        write_exr(
+            exr,
+            &result.image,
+            Some(&result.alpha()),
+            &result.layers(&scene.output.layers),
+        )
+        .map_err(|e| e.to_string())?;
         written.push(exr.display().to_string());
     }
     if !args.quiet {
@@ -264,7 +270,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             s.probed_pixels,
             s.refined_pixels,
             s.probes,
-            seconds(t.total),
+            seconds(start.elapsed()),
             s.cache_bytes as f64 / 1e6,
             s.threads,
             written.join(", ")

@@ -83,10 +83,12 @@ pub enum Command {
 pub struct RenderArgs {
     /// Scene file (TOML, see docs/scene-format.md). Without it, the built-in default scene.
     pub scene: Option<PathBuf>,
-    /// Write the PNG here (8-bit sRGB; overrides the scene's `[output]` png).
+    /// Write the PNG here (8-bit sRGB). With -o or --exr, the command line names every file
+    /// written: the scene's `[output]` png and exr are not written.
     #[arg(short, long, value_name = "OUT.png")]
     pub output: Option<PathBuf>,
-    /// Write the OpenEXR here (linear float; overrides the scene's `[output]` exr).
+    /// Write the OpenEXR here (linear float, with alpha and the scene's `[output]` layers).
+    /// With -o or --exr, the command line names every file written.
     #[arg(long, value_name = "OUT.exr")]
     pub exr: Option<PathBuf>,
     /// Subsurface method (docs/scene-format.md describes each).

@@ -11,7 +11,8 @@
 //!
 //! | channels | content |
 //! |---|---|
-//! | `R`, `G`, `B` | the beauty image (final linear RGB) |
+//! | `R`, `G`, `B` | the beauty image (final linear RGB, premultiplied by the alpha) |
+//! | `A` | alpha: the fraction of each pixel's coverage sub-samples that see a surface (if given) |
 //! | `exitance.R`, `exitance.G`, `exitance.B` | translucent exitance M_o |
 //! | `local.R`, `local.G`, `local.B` | local term of the split |
 //! | `global.R`, `global.G`, `global.B` | global term of the split |
@@ -28,7 +29,8 @@
 //!
 //! [`read_exr_rgb`] finds the channels `R`, `G`, `B` (in any part, any sample type; a part
 //! with a layer name `n` contributes channels `n.c`) and returns them as an [`RgbImage`] of
-//! the part's data window. [`read_exr`] also returns every layer it recognises: a prefix `n`
+//! the part's data window. [`read_exr`] also returns the alpha channel `A` if there is one,
+//! and every layer it recognises: a prefix `n`
 //! with channels `n.R`, `n.G`, `n.B` becomes an RGB layer, a prefix with exactly one channel a
 //! scalar layer; other channels are ignored. Malformed, truncated or oversized files
 //! (more than [`MAX_PIXELS`] per part) give an [`OutputError`], never a panic.
@@ -55,16 +57,23 @@ const MAX_CHANNELS: usize = 1024;
 pub struct ExrImage {
     /// Channels `R`, `G`, `B`.
     pub beauty: RgbImage,
+    /// Channel `A`, if the file has one.
+    pub alpha: Option<Vec<f32>>,
     /// Layers (see the module doc for what is recognised).
     pub layers: Vec<Layer>,
 }
 
-/// Writes `beauty` and `layers` into one OpenEXR file at `path`, atomically (layout in the
-/// module doc).
+/// Writes `beauty`, its `alpha` (if any) and `layers` into one OpenEXR file at `path`,
+/// atomically (layout in the module doc).
 ///
-/// Fails on a zero-sized image, an invalid or duplicate layer name, or a layer whose pixel
-/// count differs from the beauty image's.
-pub fn write_exr(path: &Path, beauty: &RgbImage, layers: &[Layer]) -> Result<(), OutputError> {
+/// Fails on a zero-sized image, an invalid or duplicate layer name, or an alpha or a layer
+/// whose pixel count differs from the beauty image's.
+pub fn write_exr(
+    path: &Path,
+    beauty: &RgbImage,
+    alpha: Option<&[f32]>,
+    layers: &[Layer],
+) -> Result<(), OutputError> {
     let (width, height) = beauty.size();
     if width == 0 || height == 0 {
         return Err(OutputError::invalid(
@@ -73,6 +82,17 @@ pub fn write_exr(path: &Path, beauty: &RgbImage, layers: &[Layer]) -> Result<(),
         ));
     }
     let n = beauty.pixels().len();
+    if let Some(alpha) = alpha
+        && alpha.len() != n
+    {
+        return Err(OutputError::invalid(
+            path,
+            format!(
+                "the alpha has {} pixels, the {width}x{height} image has {n}",
+                alpha.len()
+            ),
+        ));
+    }
     for (i, layer) in layers.iter().enumerate() {
         if !is_valid_name(&layer.name) {
             return Err(OutputError::invalid(
@@ -114,6 +134,12 @@ pub fn write_exr(path: &Path, beauty: &RgbImage, layers: &[Layer]) -> Result<(),
 
     let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
     push_rgb(path, &mut list, "", beauty.pixels())?;
+    if let Some(alpha) = alpha {
+        list.push(AnyChannel::new(
+            text(path, "A")?,
+            FlatSamples::F32(alpha.to_vec()),
+        ));
+    }
     for layer in layers {
         match &layer.data {
             LayerData::Rgb(pixels) => push_rgb(path, &mut list, &layer.name, pixels)?,
@@ -351,7 +377,22 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, OutputError> {
         }
         layers.push(layer);
     }
-    Ok(ExrImage { beauty, layers })
+    let alpha = match channels.iter().find(|c| c.name == "A") {
+        Some(a) if a.size == beauty.size() => Some(a.values.clone()),
+        Some(a) => {
+            return Err(OutputError::SizeMismatch {
+                what: "EXR alpha size vs. beauty size",
+                expected: beauty.size(),
+                actual: a.size,
+            });
+        }
+        None => None,
+    };
+    Ok(ExrImage {
+        beauty,
+        alpha,
+        layers,
+    })
 }
 
 #[cfg(test)]
@@ -401,7 +442,7 @@ mod tests {
         let path = dir.path("a.exr");
         let img = test_image(13, 7, 1);
         let layers = all_layers(13 * 7);
-        write_exr(&path, &img, &layers).unwrap();
+        write_exr(&path, &img, None, &layers).unwrap();
 
         let back = read_exr(&path).unwrap();
         assert_eq!(back.beauty, img);
@@ -410,13 +451,29 @@ mod tests {
         let mut expected = layers.clone();
         expected.sort_by(|a, b| a.name.cmp(&b.name));
         assert_eq!(back.layers, expected);
+        assert_eq!(back.alpha, None);
+    }
+
+    #[test]
+    fn alpha_round_trips_as_channel_a() {
+        let dir = TestDir::new("exr-alpha");
+        let path = dir.path("a.exr");
+        let img = test_image(5, 3, 7);
+        let alpha: Vec<f32> = (0..15).map(|i| i as f32 / 16.0).collect();
+        write_exr(&path, &img, Some(&alpha), &all_layers(15)).unwrap();
+        let back = read_exr(&path).unwrap();
+        assert_eq!(back.beauty, img);
+        assert_eq!(back.alpha.as_deref(), Some(alpha.as_slice()));
+        assert_eq!(back.layers.len(), 5, "A is not a layer");
+        let short = write_exr(&dir.path("b.exr"), &img, Some(&alpha[..14]), &[]).unwrap_err();
+        assert!(short.to_string().contains("alpha has 14 pixels"), "{short}");
     }
 
     #[test]
     fn channel_names_in_file_follow_the_documented_convention() {
         let dir = TestDir::new("exr-names");
         let path = dir.path("n.exr");
-        write_exr(&path, &test_image(2, 2, 3), &all_layers(4)).unwrap();
+        write_exr(&path, &test_image(2, 2, 3), None, &all_layers(4)).unwrap();
         let meta = MetaData::read_from_file(&path, true).unwrap();
         assert_eq!(meta.headers.len(), 1);
         let names: Vec<String> = meta.headers[0]
@@ -457,8 +514,8 @@ mod tests {
         let dir = TestDir::new("exr-det");
         let img = test_image(40, 33, 9);
         let layers = all_layers(40 * 33);
-        write_exr(&dir.path("a.exr"), &img, &layers).unwrap();
-        write_exr(&dir.path("b.exr"), &img, &layers).unwrap();
+        write_exr(&dir.path("a.exr"), &img, None, &layers).unwrap();
+        write_exr(&dir.path("b.exr"), &img, None, &layers).unwrap();
         let a = std::fs::read(dir.path("a.exr")).unwrap();
         assert_eq!(a, std::fs::read(dir.path("b.exr")).unwrap());
         assert_eq!(&a[..4], &[0x76, 0x2f, 0x31, 0x01], "OpenEXR magic");
@@ -495,13 +552,13 @@ mod tests {
             ),
         ];
         for (layers, msg) in cases {
-            let err = write_exr(&path, &img, &layers).unwrap_err();
+            let err = write_exr(&path, &img, None, &layers).unwrap_err();
             assert!(
                 err.to_string().contains(msg),
                 "{err} does not contain {msg}"
             );
         }
-        let err = write_exr(&path, &RgbImage::new(3, 0), &[]).unwrap_err();
+        let err = write_exr(&path, &RgbImage::new(3, 0), None, &[]).unwrap_err();
         assert!(err.to_string().contains("3x0"), "{err}");
         assert!(dir.entries().is_empty());
     }
@@ -574,7 +631,7 @@ mod tests {
     fn truncated_and_random_files_are_errors_not_panics() {
         let dir = TestDir::new("exr-fuzz");
         let good = dir.path("good.exr");
-        write_exr(&good, &test_image(9, 20, 2), &all_layers(180)).unwrap();
+        write_exr(&good, &test_image(9, 20, 2), None, &all_layers(180)).unwrap();
         let bytes = std::fs::read(&good).unwrap();
         let bad = dir.path("bad.exr");
 
@@ -621,7 +678,7 @@ mod tests {
     fn mutated_files_never_panic_long() {
         let dir = TestDir::new("exr-fuzz-long");
         let good = dir.path("good.exr");
-        write_exr(&good, &test_image(5, 18, 4), &all_layers(90)).unwrap();
+        write_exr(&good, &test_image(5, 18, 4), None, &all_layers(90)).unwrap();
         let bytes = std::fs::read(&good).unwrap();
         let bad = dir.path("bad.exr");
         let mut s = 0x0123456789ABCDEFu64;

@@ -143,6 +143,13 @@ pub struct Render {
 }
 
 impl Render {
+    /// Per pixel, the fraction of its coverage sub-samples that see a surface: the alpha of
+    /// the beauty image, whose radiance is already weighted by it (premultiplied, as OpenEXR
+    /// expects).
+    pub fn alpha(&self) -> Vec<f32> {
+        self.pixels.iter().map(|p| p.coverage).collect()
+    }
+
     /// The EXR layers the scene asks for, in a fixed order.
     pub fn layers(&self, wanted: &crate::scene::ExrLayers) -> Vec<Layer> {
         let rgb = |name: &str, f: fn(&PixelValue) -> Vec3| {

@@ -93,6 +93,8 @@ pub struct PixelValue {
     pub irradiance: Vec3,
     /// Distance along the view axis to the nearest surface (+∞ for none).
     pub depth: f32,
+    /// The fraction of the pixel's coverage sub-samples that see a surface (the EXR's alpha).
+    pub coverage: f32,
 }
 
 impl Default for PixelValue {
@@ -104,6 +106,7 @@ impl Default for PixelValue {
             global: Vec3::ZERO,
             irradiance: Vec3::ZERO,
             depth: f32::INFINITY,
+            coverage: 0.0,
         }
     }
 }
@@ -247,6 +250,7 @@ impl Shading<'_> {
             value.local += s.local * w;
             value.global += s.global * w;
             value.irradiance += s.irradiance * w;
+            value.coverage += w;
             if group.source == 0 && group.part == 0 {
                 value.depth = (s.position - self.camera.position).dot(forward);
             }

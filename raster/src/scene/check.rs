@@ -24,6 +24,11 @@ impl<'a> Check<'a> {
             .error(SceneErrorKind::OutOfRange, v.span(), key, message)
     }
 
+    /// The text of `v` as the scene file has it (`1e20`, not `100000000000000000000`).
+    pub fn written<T>(&self, v: &Spanned<T>) -> &'a str {
+        self.src.text.get(v.span()).unwrap_or("").trim()
+    }
+
     /// Any error at `v`.
     pub fn at<T>(
         &self,

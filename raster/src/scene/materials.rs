@@ -237,6 +237,19 @@ fn build_medium(
         }
         let scale = c.require(&key("mm_per_unit"), &m.mm_per_unit, raw, "a preset")?;
         let mm_per_unit = c.positive(&key("mm_per_unit"), scale)?;
+        if let Some(found) = lucent_core::presets::find(preset.get_ref())
+            && let Err(e) = lucent_core::Profile::from_preset(found, mm_per_unit)
+        {
+            return Err(c.range(
+                &key("mm_per_unit"),
+                scale,
+                format!(
+                    "{} is out of range for preset `{}`: {e}",
+                    c.written(scale),
+                    preset.get_ref()
+                ),
+            ));
+        }
         let medium = Medium::Preset {
             name: preset.get_ref().to_ascii_lowercase(),
             mm_per_unit,
@@ -257,6 +270,17 @@ fn build_medium(
             "must be greater than 0",
         )?;
         let eta = eta(c, &key("eta"), &m.eta, raw, what)?;
+        if let Err(e) = lucent_core::Profile::from_coefficients(sigma_a, sigma_s_prime, eta) {
+            return Err(c.range(
+                &key("sigma_a"),
+                sa,
+                format!(
+                    "{} (with sigma_s_prime = {}) is out of range: {e}",
+                    c.written(sa),
+                    c.written(ss)
+                ),
+            ));
+        }
         let medium = Medium::Coefficients {
             sigma_a,
             sigma_s_prime,
@@ -297,6 +321,24 @@ fn build_medium(
         }
     };
     let eta = eta(c, &key("eta"), &m.eta, raw, what)?;
+    let given_distance = match (&m.mean_free_path, &m.diffuse_mean_free_path) {
+        (Some(u), _) => Some(("mean_free_path", u)),
+        (_, d) => d.as_ref().map(|d| ("diffuse_mean_free_path", d)),
+    };
+    if let Err(e) = crate::material::reflectance_params(&kd, &distance, eta)
+        && let Some((name, v)) = given_distance
+    {
+        return Err(c.at(
+            SceneErrorKind::OutOfRange,
+            &key(name),
+            v,
+            format!(
+                "{} is out of range with kd = {}: {e}",
+                c.written(v),
+                c.written(kd_raw)
+            ),
+        ));
+    }
     let textured = [
         matches!(kd, ColorParam::Texture(_)).then_some("kd"),
         match &distance {

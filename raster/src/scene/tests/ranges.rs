@@ -73,6 +73,12 @@ fn material_values() {
         edit("mm_per_unit = 10", "mm_per_unit = 10\nspecular = { exponent = 9, strength = -1 }")
             => "specular", "material.m.specular.strength", "at least 0";
         lambert("1.5") => "albedo", "material.m.albedo", "[0, 1]";
+        // Valid numbers that put the dipole outside f32: the key and the value as written.
+        edit("mm_per_unit = 10", "mm_per_unit = 1e20")
+            => "mm_per_unit = 1e20", "material.m.mm_per_unit", "1e20 is out of range for preset `marble`";
+        coeffs("1e30", "1e30", "1.3") => "sigma_a", "material.m.sigma_a", "1e30 (with sigma_s_prime = 1e30) is out of range";
+        artist("0.5", "mean_free_path = 1e-30")
+            => "mean_free_path", "material.m.mean_free_path", "1e-30 is out of range with kd = 0.5";
     }
 }
 

@@ -159,3 +159,38 @@ fn a_closed_standard_output_is_not_a_crash() {
     assert!(out.status.success(), "{:?}: {stderr}", out.status);
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// Output paths on the command line replace the scene's `[output]` paths entirely: `-o` alone
+/// writes only that PNG, `--exr` alone only that EXR (with its alpha: the coverage, 0 off the
+/// object, 1 inside it, fractions on its silhouette at `aa = 2`).
+#[test]
+fn command_line_outputs_replace_the_scenes() {
+    let sb = Sandbox::new("out-replace");
+    let out = sb.run(&render(&["-o", "cli.png"]));
+    assert!(out.status.success(), "{out:?}");
+    assert!(sb.read("cli.png").starts_with(b"\x89PNG"));
+    assert_eq!(sb.read("out.png"), PREVIOUS);
+    assert_eq!(sb.read("out.exr"), PREVIOUS, "the scene's EXR was written");
+
+    let out = sb.run(&render(&["--exr", "cli.exr"]));
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(sb.read("out.png"), PREVIOUS, "the scene's PNG was written");
+    assert_eq!(sb.read("out.exr"), PREVIOUS);
+    let exr = lucent_raster::output::read_exr(&sb.path("cli.exr")).unwrap();
+    let alpha = exr.alpha.expect("an alpha channel");
+    assert_eq!(alpha.len(), exr.beauty.pixels().len());
+    assert!(alpha.iter().all(|a| (0.0..=1.0).contains(a)));
+    for wanted in [0.0, 1.0] {
+        assert!(alpha.contains(&wanted), "no pixel with alpha {wanted}");
+    }
+    assert!(
+        alpha.iter().any(|&a| a > 0.0 && a < 1.0),
+        "no partial coverage"
+    );
+    // The beauty is premultiplied: nothing where nothing is covered.
+    for (a, p) in alpha.iter().zip(exr.beauty.pixels()) {
+        if *a == 0.0 {
+            assert_eq!(p.to_array(), [0.0; 3]);
+        }
+    }
+}

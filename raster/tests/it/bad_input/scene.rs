@@ -335,7 +335,8 @@ fn scene_beyond_single_precision() {
 }
 
 /// Mean free paths the scene format accepts (> 0) but the f32 dipole cannot represent
-/// (below 2.3e-13, above about 1e12; see docs/valid-ranges.md): an error naming the material.
+/// (below 2.3e-13, above about 1e12; see docs/valid-ranges.md): an error at the key, with the
+/// value as written.
 #[test]
 fn mean_free_path_beyond_single_precision() {
     for ell in ["1e-14", "1e13"] {
@@ -344,7 +345,11 @@ fn mean_free_path_beyond_single_precision() {
         sb.fails(
             &render(&[]),
             1,
-            &["material 'm': mean free path", "single precision"],
+            &[
+                "scene.toml:",
+                &format!("material.m.mean_free_path: {ell} is out of range"),
+                "single precision",
+            ],
         );
     }
 }
