@@ -7,17 +7,25 @@
 //!
 //! - **constant** radiance L: cosine-weighted directions, p(ω) = (n·ω)/π, so
 //!   E = (π L / N) Σₖ Vₖ, exactly π L for an unoccluded point;
-//! - **map** radiance L(ω): the map's luminance-importance directions p(ω) (see
-//!   [`EnvironmentMap`]), so E = (1/N) Σₖ Vₖ L(ωₖ) max(0, n·ωₖ) / p(ωₖ); directions below
-//!   the surface's horizon contribute nothing and cost no ray.
+//! - **map** radiance L(ω): ⌈N/2⌉ directions from the map's luminance-importance density p_m
+//!   (see [`EnvironmentMap`]) and ⌊N/2⌋ cosine-weighted ones, p_c(ω) = max(0, n·ω)/π, with a
+//!   second stratified set, combined by the balance heuristic of multiple importance sampling
+//!   (Veach & Guibas 1995): E = Σₖ Vₖ L(ωₖ) max(0, n·ωₖ) / (N_m p_m(ωₖ) + N_c p_c(ωₖ)) over
+//!   both sets. The map's density finds small bright sources (a sun); the cosine density
+//!   makes a smooth sky over an open receiver nearly exact, where luminance sampling alone
+//!   leaves the cosine's variation as noise. Directions below the surface's horizon
+//!   contribute nothing and cost no ray.
 //!
 //! The reported incident direction (used by the specular highlight, which treats each light
 //! as coming from one direction) is the contribution-weighted mean of the visible directions.
 
 use glam::{Vec2, Vec3};
 
+use std::f32::consts::FRAC_1_PI;
+
 use super::{EnvironmentMap, Incident, Lighting, luminance, strata};
 use crate::geometry::ShadowHint;
+use crate::sampling::rng::splitmix64;
 
 /// The cosine-weighted direction about `n` (with tangents `t`, `b`) for the variates `u`
 /// (Malley's method: uniform on the disk by polar coordinates, lifted to the hemisphere).
@@ -64,22 +72,52 @@ impl Lighting<'_> {
                 sum = radiance * (std::f32::consts::PI * visible as f32);
             }
             Some(map) => {
-                let turn = rotation_degrees.to_radians().sin_cos();
-                let turn = (turn.1, turn.0);
-                for u in strata(count, seed) {
+                if map.is_black() {
+                    return None;
+                }
+                let (sin, cos) = rotation_degrees.to_radians().sin_cos();
+                let (to_world, to_map) = ((cos, sin), (cos, -sin));
+                // Half the rays (the odd one included) from the map's density, half
+                // cosine-weighted; each weighed by the balance heuristic.
+                let from_map = count.div_ceil(2);
+                let from_cosine = count - from_map;
+                let (nm, nc) = (from_map as f32, from_cosine as f32);
+                let mut add = |dir: Vec3, texel: Vec3, pdf_map: f32, cos: f32| {
+                    if self.visible(p, n, dir, f32::MAX, hint) {
+                        let e = texel * (cos / (nm * pdf_map + nc * cos * FRAC_1_PI));
+                        sum += e;
+                        toward += dir * luminance(e);
+                    }
+                };
+                for u in strata(from_map, seed) {
                     let Some(s) = map.sample(u) else {
                         return None;
                     };
-                    let dir = rotate_z(s.direction, turn);
+                    let dir = rotate_z(s.direction, to_world);
                     let cos = n.dot(dir);
-                    if cos <= 0.0 || !self.visible(p, n, dir, f32::MAX, hint) {
-                        continue;
+                    if cos > 0.0 {
+                        add(dir, s.radiance, s.pdf, cos);
                     }
-                    let e = s.radiance * (cos / s.pdf);
-                    sum += e;
-                    toward += dir * luminance(e);
+                }
+                if from_cosine > 0 {
+                    let (t, b) = n.any_orthonormal_pair();
+                    for u in strata(from_cosine, splitmix64(seed)) {
+                        let dir = cosine_direction(n, t, b, u);
+                        let cos = n.dot(dir);
+                        let (texel, pdf_map) = map.radiance_and_pdf(rotate_z(dir, to_map));
+                        if cos > 0.0 && texel.max_element() > 0.0 {
+                            add(dir, texel, pdf_map, cos);
+                        }
+                    }
                 }
                 sum *= radiance;
+                if !(sum.max_element() > 0.0) {
+                    return None;
+                }
+                return Some(Incident {
+                    direction: toward.normalize_or(n),
+                    irradiance: sum,
+                });
             }
         }
         if !(sum.max_element() > 0.0) {

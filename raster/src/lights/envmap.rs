@@ -25,9 +25,10 @@
 //! row_cdf:     [ 0, c_1, …, c_H = 1 ]               H + 1   marginal over rows
 //! column_cdf:  [ row 0: 0, …, 1 | row 1: 0, …, 1 | … ]   H × (W + 1)   conditional per row
 //! row_solid_angle: [ ΔΩ_0, …, ΔΩ_{H−1} ]            H       solid angle of one texel per row
+//! row_cos:     [ cos θ_0 = 1, cos θ_1, …, cos θ_H = −1 ]   H + 1   the rows' boundaries
 //! ```
 //!
-//! 4 (W + 2) bytes per row beyond the texture (about 4 bytes per texel). A row with no light
+//! 4 (W + 4) bytes per row beyond the texture (about 4 bytes per texel). A row with no light
 //! keeps a flat conditional CDF (never chosen, since its marginal step is 0).
 
 use std::f64::consts::PI as PI64;
@@ -52,6 +53,7 @@ pub struct EnvironmentMap {
     row_cdf: Vec<f32>,
     column_cdf: Vec<f32>,
     row_solid_angle: Vec<f32>,
+    row_cos: Vec<f32>,
     /// Σ ℓ ΔΩ over all texels: the map's luminance integrated over the sphere.
     total: f64,
 }
@@ -123,6 +125,9 @@ impl EnvironmentMap {
             row_cdf,
             column_cdf,
             row_solid_angle: row_solid_angle.iter().map(|&a| a as f32).collect(),
+            row_cos: (0..=h)
+                .map(|j| (PI64 * j as f64 / h as f64).cos() as f32)
+                .collect(),
             total,
         };
         debug_assert_eq!(map.validate(), Ok(()));
@@ -146,6 +151,7 @@ impl EnvironmentMap {
         if self.row_cdf.len() != h + 1
             || self.column_cdf.len() != h * (w + 1)
             || self.row_solid_angle.len() != h
+            || self.row_cos.len() != h + 1
         {
             return Err("column sizes do not match the texture".into());
         }
@@ -165,6 +171,12 @@ impl EnvironmentMap {
             || (sphere - 4.0 * PI64).abs() > 1e-4 * 4.0 * PI64
         {
             return Err(format!("texel solid angles sum to {sphere}, not 4π"));
+        }
+        if self.row_cos[0] != 1.0
+            || self.row_cos[h] != -1.0
+            || self.row_cos.windows(2).any(|c| !(c[0] > c[1]))
+        {
+            return Err("the rows' cos θ boundaries do not fall from 1 to −1".into());
         }
         if !(self.total >= 0.0) || !self.total.is_finite() {
             return Err(format!("total luminance {} is not finite", self.total));
@@ -187,22 +199,27 @@ impl EnvironmentMap {
 
     /// Radiance arriving from the map-frame direction `d` (unit).
     pub fn radiance(&self, d: Vec3) -> Vec3 {
-        let (i, j) = self.texel_of(d);
-        self.texture.texels[j * self.texture.width as usize + i]
+        self.radiance_and_pdf(d).0
     }
 
     /// The sampling density in solid angle at the map-frame direction `d` (unit); 0 for a
     /// black map.
     pub fn pdf(&self, d: Vec3) -> f32 {
-        if self.is_black() {
-            return 0.0;
-        }
+        self.radiance_and_pdf(d).1
+    }
+
+    /// [`EnvironmentMap::radiance`] and [`EnvironmentMap::pdf`] from one texel lookup.
+    pub fn radiance_and_pdf(&self, d: Vec3) -> (Vec3, f32) {
         let (i, j) = self.texel_of(d);
         let w = self.texture.width as usize;
+        let radiance = self.texture.texels[j * w + i];
+        if self.is_black() {
+            return (radiance, 0.0);
+        }
         let row = self.row_cdf[j + 1] - self.row_cdf[j];
         let cdf = &self.column_cdf[j * (w + 1)..];
         let column = cdf[i + 1] - cdf[i];
-        row * column / self.row_solid_angle[j]
+        (radiance, row * column / self.row_solid_angle[j])
     }
 
     /// The direction for the uniform variates `u ∈ [0, 1)²` (`u.y` picks the row, `u.x` the
@@ -211,22 +228,20 @@ impl EnvironmentMap {
         if self.is_black() {
             return None;
         }
-        let (w, h) = (self.texture.width as usize, self.texture.height as usize);
+        let w = self.texture.width as usize;
         let (j, fy) = pick(&self.row_cdf, u.y);
         let cdf = &self.column_cdf[j * (w + 1)..(j + 1) * (w + 1)];
         let (i, fx) = pick(cdf, u.x);
         let row_p = self.row_cdf[j + 1] - self.row_cdf[j];
         let column_p = cdf[i + 1] - cdf[i];
         // Uniform in solid angle within the texel: uniform in φ and in cos θ.
-        let (cos_top, cos_bottom) = (
-            (std::f32::consts::PI * j as f32 / h as f32).cos(),
-            (std::f32::consts::PI * (j + 1) as f32 / h as f32).cos(),
-        );
+        let (cos_top, cos_bottom) = (self.row_cos[j], self.row_cos[j + 1]);
         let cos_theta = (cos_top + fy * (cos_bottom - cos_top)).clamp(-1.0, 1.0);
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let phi = std::f32::consts::TAU * (i as f32 + fx) / w as f32;
+        let (sin_phi, cos_phi) = phi.sin_cos();
         Some(MapSample {
-            direction: Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta),
+            direction: Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta),
             radiance: self.texture.texels[j * w + i],
             pdf: row_p * column_p / self.row_solid_angle[j],
         })
