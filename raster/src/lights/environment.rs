@@ -90,9 +90,7 @@ impl Lighting<'_> {
                     }
                 };
                 for u in strata(from_map, seed) {
-                    let Some(s) = map.sample(u) else {
-                        return None;
-                    };
+                    let s = map.sample(u)?;
                     let dir = rotate_z(s.direction, to_world);
                     let cos = n.dot(dir);
                     if cos > 0.0 {

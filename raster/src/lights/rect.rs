@@ -46,7 +46,10 @@ pub struct RectFrame {
 impl RectFrame {
     /// The four corners, counter-clockwise seen from the lit side.
     pub fn corners(&self) -> [Vec3; 4] {
-        let (x, y) = (self.right * (0.5 * self.size.x), self.up * (0.5 * self.size.y));
+        let (x, y) = (
+            self.right * (0.5 * self.size.x),
+            self.up * (0.5 * self.size.y),
+        );
         let c = self.center;
         [c - x - y, c + x - y, c + x + y, c - x + y]
     }
@@ -190,7 +193,10 @@ mod tests {
             assert!(a.dot(b).abs() < 1e-6);
         }
         assert!((right.length() - 1.0).abs() < 1e-6 && (up.length() - 1.0).abs() < 1e-6);
-        assert!((right.cross(up) - d).length() < 1e-5, "right-handed: r × u = d");
+        assert!(
+            (right.cross(up) - d).length() < 1e-5,
+            "right-handed: r × u = d"
+        );
         // A given up parallel to the direction, or zero, has no frame.
         assert_eq!(rect_frame(Vec3::Z, Some(Vec3::new(0.0, 0.0, -3.0))), None);
         assert_eq!(rect_frame(Vec3::Z, Some(Vec3::ZERO)), None);
@@ -208,7 +214,10 @@ mod tests {
             (Vec3::ZERO, Vec3::Z),
             (Vec3::new(0.4, -0.7, 0.3), Vec3::Z),
             (Vec3::new(2.5, 1.5, 0.0), tilted),
-            (Vec3::new(-3.0, 0.5, 1.0), Vec3::new(0.6, 0.0, 1.0).normalize()),
+            (
+                Vec3::new(-3.0, 0.5, 1.0),
+                Vec3::new(0.6, 0.0, 1.0).normalize(),
+            ),
         ];
         for (p, n) in cases {
             let corners = frame.corners();
@@ -250,8 +259,14 @@ mod tests {
         assert!((e - want).abs() / want < 5e-3, "{e} vs {want}");
         // Behind the emitting face, and in its plane: nothing.
         let l = Lighting::new(&lights, None, 100.0);
-        assert_eq!(l.irradiance(Vec3::new(0.0, 0.0, 1.0), -Vec3::Z, 5), Vec3::ZERO);
-        assert_eq!(l.irradiance(Vec3::new(3.0, 0.0, 0.0), -Vec3::X, 5), Vec3::ZERO);
+        assert_eq!(
+            l.irradiance(Vec3::new(0.0, 0.0, 1.0), -Vec3::Z, 5),
+            Vec3::ZERO
+        );
+        assert_eq!(
+            l.irradiance(Vec3::new(3.0, 0.0, 0.0), -Vec3::X, 5),
+            Vec3::ZERO
+        );
     }
 
     #[test]

@@ -14,7 +14,14 @@ use crate::lights::{EnvironmentMap, rect_frame};
 use crate::texture::TextureEncoding;
 
 /// Light types accepted by `type`.
-pub const LIGHT_TYPES: [&str; 6] = ["point", "spot", "directional", "sphere", "rect", "environment"];
+pub const LIGHT_TYPES: [&str; 6] = [
+    "point",
+    "spot",
+    "directional",
+    "sphere",
+    "rect",
+    "environment",
+];
 
 /// Default shadow samples of a sphere light.
 pub const DEFAULT_SPHERE_SAMPLES: u32 = 16;

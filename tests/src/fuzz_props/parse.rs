@@ -10,10 +10,10 @@
 use std::borrow::Cow;
 
 use lucent_core::QuerySettings;
+use lucent_core::glam::Vec3;
 use lucent_raster::raster::MAX_AA;
 use lucent_raster::scene::mesh::validate_mesh;
 use lucent_raster::scene::obj::parse_obj;
-use lucent_core::glam::Vec3;
 use lucent_raster::scene::{Light, Mesh, SceneOrigin, parse_scene};
 
 /// A small closed mesh (a tetrahedron with UVs and normals) served under the bunny's path, so
@@ -46,7 +46,10 @@ pub fn fuzz_origin() -> SceneOrigin {
                 Cow::Borrowed(SMALL_MESH_OBJ.as_bytes()),
             ),
             ("textures/mfp-ramp.png".to_string(), Cow::Borrowed(RAMP_PNG)),
-            ("textures/sky-latlong.png".to_string(), Cow::Borrowed(SKY_PNG)),
+            (
+                "textures/sky-latlong.png".to_string(),
+                Cow::Borrowed(SKY_PNG),
+            ),
         ],
     }
 }

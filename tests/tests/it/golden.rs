@@ -67,8 +67,14 @@ fn scenes() -> Vec<(&'static str, Scene)> {
             small(load("scenes/textured-mfp.toml"), 64, 3000),
         ),
         ("opaque", small(load("tests/data/opaque.toml"), 64, 1000)),
-        ("rect-light", small(load("scenes/rect-light.toml"), 64, 2000)),
-        ("environment", small(load("scenes/environment.toml"), 64, 3000)),
+        (
+            "rect-light",
+            small(load("scenes/rect-light.toml"), 64, 2000),
+        ),
+        (
+            "environment",
+            small(load("scenes/environment.toml"), 64, 3000),
+        ),
     ]
 }
 

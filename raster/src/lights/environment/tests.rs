@@ -55,7 +55,10 @@ fn a_constant_sky_gives_pi_l_exactly() {
         for n in normals() {
             for seed in 0..20 {
                 let e = l.irradiance(Vec3::new(1.0, 2.0, 3.0), n, seed);
-                assert!((e - want).abs().max_element() <= 1e-6 * want.x, "{e} vs {want}");
+                assert!(
+                    (e - want).abs().max_element() <= 1e-6 * want.x,
+                    "{e} vs {want}"
+                );
             }
         }
     }
@@ -80,7 +83,10 @@ fn a_uniform_map_gives_pi_l() {
             .fold(0.0, f64::max);
         eprintln!("uniform map, n {n}: mean/πL {}, worst {worst}", mean / want);
         // 256 points of about 4 % spread each: a standard error near 0.25 %.
-        assert!((mean - want).abs() / want < 1e-2, "{n}: mean {mean} vs {want}");
+        assert!(
+            (mean - want).abs() / want < 1e-2,
+            "{n}: mean {mean} vs {want}"
+        );
         assert!(worst < 0.15, "{n}: worst {worst}");
     }
 }
@@ -164,7 +170,11 @@ fn a_bright_region_matches_its_quadrature_and_converges() {
                 let reference: f64 = (0..h)
                     .flat_map(|j| (0..w).map(move |i| (i, j)))
                     .map(|(i, j)| {
-                        let l = if block(i, j) { bright.x as f64 } else { background as f64 };
+                        let l = if block(i, j) {
+                            bright.x as f64
+                        } else {
+                            background as f64
+                        };
                         l * texel_cosine_integral(
                             i,
                             j,
@@ -247,7 +257,11 @@ fn the_sampling_density_is_a_density() {
         let p = m.pdf(s.direction);
         assert!((s.pdf - p).abs() <= 1e-4 * p, "{} vs {p}", s.pdf);
         assert_eq!(s.radiance, m.radiance(s.direction));
-        let phi = s.direction.y.atan2(s.direction.x).rem_euclid(std::f32::consts::TAU);
+        let phi = s
+            .direction
+            .y
+            .atan2(s.direction.x)
+            .rem_euclid(std::f32::consts::TAU);
         let i = ((phi / std::f32::consts::TAU * w as f32) as u32).min(w - 1);
         let j = ((s.direction.z.acos() / std::f32::consts::PI * h as f32) as u32).min(h - 1);
         counts[(j * w + i) as usize] += 1;
@@ -298,7 +312,9 @@ fn the_lat_long_convention_and_rotation() {
     });
     let e = |m: &Arc<EnvironmentMap>, rotation: f32, n: Vec3| {
         let lights = [env(Some(m.clone()), rotation, 256)];
-        Lighting::new(&lights, None, 1.0).irradiance(Vec3::ZERO, n, 3).x
+        Lighting::new(&lights, None, 1.0)
+            .irradiance(Vec3::ZERO, n, 3)
+            .x
     };
     assert!(e(&top, 0.0, Vec3::Z) > 0.1);
     assert_eq!(e(&top, 0.0, -Vec3::Z), 0.0);
@@ -314,7 +330,9 @@ fn the_lat_long_convention_and_rotation() {
         let turned = Vec3::new(-n.y, n.x, n.z); // n turned by +90° about z
         let fine = |rotation: f32, n: Vec3| {
             let lights = [env(Some(quarter.clone()), rotation, 4096)];
-            Lighting::new(&lights, None, 1.0).irradiance(Vec3::ZERO, n, 3).x
+            Lighting::new(&lights, None, 1.0)
+                .irradiance(Vec3::ZERO, n, 3)
+                .x
         };
         let (a, b) = (fine(90.0, turned), fine(0.0, n));
         assert!((a - b).abs() <= 5e-3 * b.max(1e-3), "{n}: {a} vs {b}");
@@ -331,9 +349,12 @@ fn bad_maps_are_refused_and_black_maps_are_dark() {
             texels,
         })
     };
-    let err = EnvironmentMap::new(texture(vec![Vec3::ONE, Vec3::new(1.0, f32::NAN, 0.0)]))
-        .unwrap_err();
-    assert!(err.contains("column 1, row 0") && err.contains("finite"), "{err}");
+    let err =
+        EnvironmentMap::new(texture(vec![Vec3::ONE, Vec3::new(1.0, f32::NAN, 0.0)])).unwrap_err();
+    assert!(
+        err.contains("column 1, row 0") && err.contains("finite"),
+        "{err}"
+    );
     let err = EnvironmentMap::new(texture(vec![Vec3::new(0.0, -1.0, 0.0), Vec3::ONE])).unwrap_err();
     assert!(err.contains("column 0, row 0"), "{err}");
     assert!(EnvironmentMap::new(texture(vec![Vec3::ONE])).is_err());
@@ -345,4 +366,3 @@ fn bad_maps_are_refused_and_black_maps_are_dark() {
         Vec3::ZERO
     );
 }
-

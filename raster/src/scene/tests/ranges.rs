@@ -2,8 +2,8 @@
 
 use super::*;
 
-use glam::Vec3;
 use SceneErrorKind::OutOfRange as R;
+use glam::Vec3;
 
 #[test]
 fn camera_values() {
@@ -204,13 +204,18 @@ fn rect_and_environment_lights_load() {
         [Light::Environment { map: None, samples: 64, rotation_degrees: 0.0, intensity: 0.5, color, .. }]
             if *color == Vec3::new(1.0, 0.5, 0.25)
     ));
-    let s = load(&environment("intensity = 2\nmap = 'ramp.png'\nrotation = -90")).unwrap();
+    let s = load(&environment(
+        "intensity = 2\nmap = 'ramp.png'\nrotation = -90",
+    ))
+    .unwrap();
     match &s.lights[..] {
-        [Light::Environment {
-            map: Some(map),
-            rotation_degrees,
-            ..
-        }] => {
+        [
+            Light::Environment {
+                map: Some(map),
+                rotation_degrees,
+                ..
+            },
+        ] => {
             assert_eq!(*rotation_degrees, -90.0);
             assert_eq!((map.texture().width, map.texture().height), (8, 1));
             assert_eq!(map.validate(), Ok(()));
