@@ -478,10 +478,21 @@ mod tests {
             color: Vec3::ONE,
             irradiance: 1.0,
         };
+        let rect = Light::Rect {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            normal: -Vec3::Z,
+            right: -Vec3::X,
+            up_axis: Vec3::Y,
+            size: Vec2::new(0.4, 0.3),
+            color: Vec3::ONE,
+            intensity: 25.0,
+            samples: 4,
+        };
         for light in [
             point_light(Vec3::new(0.0, 0.0, 5.0), 25.0),
             sphere,
             directional,
+            rect,
         ] {
             let lights = [light];
             let open = Lighting::new(&lights, None, 5.0).irradiance(Vec3::ZERO, Vec3::Z, 3);
@@ -593,12 +604,22 @@ mod tests {
             },
             // Below the surface: never reaches it.
             point_light(Vec3::new(0.0, 0.0, -3.0), 4.0),
+            Light::Rect {
+                center: Vec3::new(-2.0, 0.0, 4.0),
+                normal: -Vec3::Z,
+                right: -Vec3::X,
+                up_axis: Vec3::Y,
+                size: Vec2::new(1.0, 2.0),
+                color: Vec3::ONE,
+                intensity: 9.0,
+                samples: 16,
+            },
         ];
         let mut tris = plate(-3.0, -0.5, 1.5).to_vec();
         tris.extend(plate(0.7, 1.5, 1.0));
         let bvh = Bvh::build(&tris);
         let mut hints = ShadowHints::default();
-        let mut seen = [[false; 2]; 5];
+        let mut seen = [[false; 2]; 6];
         for i in 0..400 {
             let p = Vec3::new(-4.0 + i as f32 * 0.02, 0.1, 0.0);
             let mask = Lighting::new(&lights, Some(&bvh), 5.0).reach_mask(p, Vec3::Z, &mut hints);
@@ -606,7 +627,7 @@ mod tests {
                 let bit = mask >> k & 1 == 1;
                 seen[k][usize::from(bit)] = true;
                 let want = match *light {
-                    Light::Sphere { center, .. } => {
+                    Light::Sphere { center, .. } | Light::Rect { center, .. } => {
                         let point = [point_light(center, 1.0)];
                         Lighting::new(&point, Some(&bvh), 5.0)
                             .irradiance(p, Vec3::Z, 0)
@@ -627,6 +648,7 @@ mod tests {
         // Every light but the one below is both seen and hidden somewhere along the row.
         assert_eq!(seen[..4], [[true, true]; 4]);
         assert_eq!(seen[4], [true, false]);
+        assert_eq!(seen[5], [true, true]);
         assert_eq!(mask_bits_beyond_32(), 0);
     }
 
