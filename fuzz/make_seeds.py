@@ -165,7 +165,7 @@ def table_seeds():
 # ------------------------------------------------------------------------ scene_parse_never_panics
 def scene_seeds():
     t = "scene_parse_never_panics"
-    for name in ("default", "sphere-shadow", "textured-mfp"):
+    for name in ("default", "sphere-shadow", "textured-mfp", "rect-light", "environment"):
         with open(os.path.join(ROOT, "scenes", name + ".toml"), "rb") as f:
             write(t, name + ".toml", f.read())
     every = b"""

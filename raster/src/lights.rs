@@ -6,6 +6,11 @@
 //! gives E = irradiance × cos θ. A sphere light of radius r has radiance L = I/(π r²), which
 //! makes it deliver the same E as a point light of intensity I when fully visible; its soft
 //! shadows come from `samples` stratified directions in the cone it subtends, each traced.
+//! A rect light of area A has radiance L = I/A (I its intensity along its normal), and is
+//! sampled at stratified points on its area ([`rect`]); an environment is a radiance at
+//! infinity, constant or a lat-long map, sampled by cosine-weighted or luminance-importance
+//! directions ([`environment`], [`EnvironmentMap`]). Every area light draws its `samples`
+//! variates from the same stratified square ([`strata`]), rotated per point by a hash.
 //!
 //! Shadow rays start off the surface (see [`offset_origin`]) and test every triangle of the
 //! scene through the BVH; a scene where nothing can occlude passes `None` and traces nothing.
@@ -14,8 +19,15 @@ use glam::{Vec2, Vec3};
 
 use crate::geometry::{Bvh, ShadowHint, offset_origin};
 use crate::sampling::rng::splitmix64;
-use crate::sampling::stratified_square;
+use crate::sampling::{StratifiedSquare, stratified_square};
 use crate::scene::Light;
+
+mod environment;
+mod envmap;
+mod rect;
+
+pub use envmap::{EnvironmentMap, MapSample, luminance};
+pub use rect::{RectFrame, rect_frame};
 
 /// One light's contribution at a point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -192,6 +204,46 @@ impl<'a> Lighting<'a> {
                     splitmix64(seed ^ index as u64),
                     hint,
                 ),
+                Light::Rect {
+                    center,
+                    normal,
+                    right,
+                    up_axis,
+                    size,
+                    color,
+                    intensity,
+                    samples,
+                } => self.rect(
+                    p,
+                    n,
+                    &RectFrame {
+                        center,
+                        normal,
+                        right,
+                        up: up_axis,
+                        size,
+                    },
+                    color * intensity,
+                    samples,
+                    splitmix64(seed ^ index as u64),
+                    hint,
+                ),
+                Light::Environment {
+                    color,
+                    intensity,
+                    ref map,
+                    rotation_degrees,
+                    samples,
+                } => self.environment(
+                    p,
+                    n,
+                    color * intensity,
+                    map.as_deref(),
+                    rotation_degrees,
+                    samples,
+                    splitmix64(seed ^ index as u64),
+                    hint,
+                ),
             };
             if let Some(i) = incident {
                 f(i);
@@ -202,7 +254,7 @@ impl<'a> Lighting<'a> {
     /// Which of the first [`Lighting::MASK_LIGHTS`] lights reach `p` on a surface with unit
     /// normal `n`, one bit each (bit `i` for light `i`), from one shadow ray per light: the
     /// light faces the surface, `p` is inside a spot's outer cone, and the ray is unoccluded
-    /// (a sphere light's ray aims at its centre). Cheaper than [`Lighting::for_each`] (one ray
+    /// (a sphere or rect light's ray aims at its centre; an environment's follows the normal). Cheaper than [`Lighting::for_each`] (one ray
     /// per sphere light instead of its `samples`); it tells apart points on either side of a
     /// shadow edge, not how much light arrives.
     pub fn reach_mask(&self, p: Vec3, n: Vec3, hints: &mut ShadowHints) -> u32 {
@@ -243,6 +295,11 @@ impl<'a> Lighting<'a> {
                     // Inside the light counts as lit, as in `sphere`.
                     (center - p).length() <= radius || towards(center, radius, hint)
                 }
+                Light::Rect { center, normal, .. } => {
+                    (p - center).dot(normal) > 0.0 && towards(center, 0.0, hint)
+                }
+                // The ray along the normal: open sky above the point or not.
+                Light::Environment { .. } => self.visible(p, n, n, f32::MAX, hint),
             };
             if reaches {
                 mask |= 1 << index;
@@ -303,13 +360,9 @@ impl<'a> Lighting<'a> {
         let solid_angle = std::f32::consts::TAU * (1.0 - cos_max);
         let radiance = intensity / (std::f32::consts::PI * radius * radius);
         let (t, b) = axis.any_orthonormal_pair();
-        let rotation = Vec2::new(
-            (seed >> 40) as f32 / (1u64 << 24) as f32,
-            ((seed >> 16) & 0xff_ffff) as f32 / (1u64 << 24) as f32,
-        );
         let mut sum = 0.0;
         let count = samples.max(1);
-        for u in stratified_square(count, rotation) {
+        for u in strata(count, seed) {
             let cos_a = 1.0 - u.x * (1.0 - cos_max);
             let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
             let phi = std::f32::consts::TAU * u.y;
@@ -334,6 +387,18 @@ impl<'a> Lighting<'a> {
             irradiance: radiance * (solid_angle * sum / count as f32),
         })
     }
+}
+
+/// The `count` variates of an area light at one point: [`stratified_square`] with a
+/// Cranley–Patterson rotation taken from the point's `seed` (24 bits per axis), so that
+/// neighbouring points see different, equally stratified patterns and the result does not
+/// depend on the order points are lit in.
+pub fn strata(count: u32, seed: u64) -> StratifiedSquare {
+    let rotation = Vec2::new(
+        (seed >> 40) as f32 / (1u64 << 24) as f32,
+        ((seed >> 16) & 0xff_ffff) as f32 / (1u64 << 24) as f32,
+    );
+    stratified_square(count, rotation)
 }
 
 fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {
@@ -413,10 +478,21 @@ mod tests {
             color: Vec3::ONE,
             irradiance: 1.0,
         };
+        let rect = Light::Rect {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            normal: -Vec3::Z,
+            right: -Vec3::X,
+            up_axis: Vec3::Y,
+            size: Vec2::new(0.4, 0.3),
+            color: Vec3::ONE,
+            intensity: 25.0,
+            samples: 4,
+        };
         for light in [
             point_light(Vec3::new(0.0, 0.0, 5.0), 25.0),
             sphere,
             directional,
+            rect,
         ] {
             let lights = [light];
             let open = Lighting::new(&lights, None, 5.0).irradiance(Vec3::ZERO, Vec3::Z, 3);
@@ -528,12 +604,22 @@ mod tests {
             },
             // Below the surface: never reaches it.
             point_light(Vec3::new(0.0, 0.0, -3.0), 4.0),
+            Light::Rect {
+                center: Vec3::new(-2.0, 0.0, 4.0),
+                normal: -Vec3::Z,
+                right: -Vec3::X,
+                up_axis: Vec3::Y,
+                size: Vec2::new(1.0, 2.0),
+                color: Vec3::ONE,
+                intensity: 9.0,
+                samples: 16,
+            },
         ];
         let mut tris = plate(-3.0, -0.5, 1.5).to_vec();
         tris.extend(plate(0.7, 1.5, 1.0));
         let bvh = Bvh::build(&tris);
         let mut hints = ShadowHints::default();
-        let mut seen = [[false; 2]; 5];
+        let mut seen = [[false; 2]; 6];
         for i in 0..400 {
             let p = Vec3::new(-4.0 + i as f32 * 0.02, 0.1, 0.0);
             let mask = Lighting::new(&lights, Some(&bvh), 5.0).reach_mask(p, Vec3::Z, &mut hints);
@@ -541,7 +627,7 @@ mod tests {
                 let bit = mask >> k & 1 == 1;
                 seen[k][usize::from(bit)] = true;
                 let want = match *light {
-                    Light::Sphere { center, .. } => {
+                    Light::Sphere { center, .. } | Light::Rect { center, .. } => {
                         let point = [point_light(center, 1.0)];
                         Lighting::new(&point, Some(&bvh), 5.0)
                             .irradiance(p, Vec3::Z, 0)
@@ -562,6 +648,7 @@ mod tests {
         // Every light but the one below is both seen and hidden somewhere along the row.
         assert_eq!(seen[..4], [[true, true]; 4]);
         assert_eq!(seen[4], [true, false]);
+        assert_eq!(seen[5], [true, true]);
         assert_eq!(mask_bits_beyond_32(), 0);
     }
 

@@ -110,6 +110,10 @@ pub(crate) struct RawLight {
     pub inner_angle: Option<Num>,
     pub outer_angle: Option<Num>,
     pub samples: Option<Int>,
+    pub size: Option<Spanned<Components>>,
+    pub up: Option<Vec3Raw>,
+    pub map: Option<Str>,
+    pub rotation: Option<Num>,
 }
 
 /// `[render]`.

@@ -1,24 +1,48 @@
 //! `[[light]]` tables → [`Light`]: each type's required keys, defaults and ranges.
 
-use glam::Vec3;
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
 use toml::Spanned;
 
 use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::{Components, RawLight};
+use super::materials::TextureCache;
 use super::model::Light;
+use crate::lights::{EnvironmentMap, rect_frame};
+use crate::texture::TextureEncoding;
 
 /// Light types accepted by `type`.
-pub const LIGHT_TYPES: [&str; 4] = ["point", "spot", "directional", "sphere"];
+pub const LIGHT_TYPES: [&str; 6] = [
+    "point",
+    "spot",
+    "directional",
+    "sphere",
+    "rect",
+    "environment",
+];
 
 /// Default shadow samples of a sphere light.
 pub const DEFAULT_SPHERE_SAMPLES: u32 = 16;
 
-/// Largest number of shadow samples of a sphere light.
+/// Largest number of shadow samples of a sphere light (and of a rect or environment light).
 pub const MAX_SPHERE_SAMPLES: i64 = 4096;
 
-/// Builds the light `index` (its key prefix is `light[index]`).
-pub(crate) fn build_light(c: &Check, index: usize, raw: &Spanned<RawLight>) -> Checked<Light> {
+/// Default shadow samples of a rect light (as for a sphere light).
+pub const DEFAULT_RECT_SAMPLES: u32 = DEFAULT_SPHERE_SAMPLES;
+
+/// Default shadow rays of an environment light (`docs/physics.md` §5.2 measures their noise).
+pub const DEFAULT_ENVIRONMENT_SAMPLES: u32 = 64;
+
+/// Builds the light `index` (its key prefix is `light[index]`); an environment's `map` is read
+/// through `textures`.
+pub(crate) fn build_light(
+    c: &Check,
+    index: usize,
+    raw: &Spanned<RawLight>,
+    textures: &mut TextureCache,
+) -> Checked<Light> {
     let l = raw.get_ref();
     let key = |k: &str| format!("light[{index}].{k}");
     let color = match &l.color {
@@ -31,6 +55,8 @@ pub(crate) fn build_light(c: &Check, index: usize, raw: &Spanned<RawLight>) -> C
         "spot" => "a spot light",
         "directional" => "a directional light",
         "sphere" => "a sphere light",
+        "rect" => "a rect light",
+        "environment" => "an environment light",
         other => {
             return Err(c.at(
                 SceneErrorKind::UnknownName,
@@ -52,7 +78,12 @@ pub(crate) fn build_light(c: &Check, index: usize, raw: &Spanned<RawLight>) -> C
                 "position" | "direction" | "intensity" | "inner_angle" | "outer_angle"
             ),
             "directional" => matches!(k, "direction" | "irradiance"),
-            _ => matches!(k, "center" | "radius" | "intensity" | "samples"),
+            "sphere" => matches!(k, "center" | "radius" | "intensity" | "samples"),
+            "rect" => matches!(
+                k,
+                "position" | "direction" | "size" | "up" | "intensity" | "samples"
+            ),
+            _ => matches!(k, "map" | "rotation" | "intensity" | "samples"),
         }
     };
     let spans = [
@@ -65,6 +96,10 @@ pub(crate) fn build_light(c: &Check, index: usize, raw: &Spanned<RawLight>) -> C
         ("inner_angle", l.inner_angle.as_ref().map(|v| v.span())),
         ("outer_angle", l.outer_angle.as_ref().map(|v| v.span())),
         ("samples", l.samples.as_ref().map(|v| v.span())),
+        ("size", l.size.as_ref().map(|v| v.span())),
+        ("up", l.up.as_ref().map(|v| v.span())),
+        ("map", l.map.as_ref().map(|v| v.span())),
+        ("rotation", l.rotation.as_ref().map(|v| v.span())),
     ];
     for (k, span) in spans {
         if let Some(span) = span
@@ -91,6 +126,12 @@ pub(crate) fn build_light(c: &Check, index: usize, raw: &Spanned<RawLight>) -> C
     let position = |c: &Check, k: &str, v: &Option<Spanned<Components>>| -> Checked<Vec3> {
         let v = c.require(&key(k), v, raw, what)?;
         c.vec3(&key(k), v)
+    };
+    let samples = |c: &Check, default: u32| -> Checked<u32> {
+        match &l.samples {
+            Some(v) => Ok(c.int(&key("samples"), v, 1, MAX_SPHERE_SAMPLES)? as u32),
+            None => Ok(default),
+        }
     };
     Ok(match kind {
         "point" => Light::Point {
@@ -133,20 +174,90 @@ pub(crate) fn build_light(c: &Check, index: usize, raw: &Spanned<RawLight>) -> C
                 irradiance: c.non_negative(&key("irradiance"), v)?,
             }
         }
-        _ => {
+        "sphere" => {
             let center = position(c, "center", &l.center)?;
             let r = c.require(&key("radius"), &l.radius, raw, what)?;
             let radius = c.positive(&key("radius"), r)?;
-            let samples = match &l.samples {
-                Some(v) => c.int(&key("samples"), v, 1, MAX_SPHERE_SAMPLES)? as u32,
-                None => DEFAULT_SPHERE_SAMPLES,
-            };
             Light::Sphere {
                 center,
                 radius,
                 color,
                 intensity: intensity(c)?,
-                samples,
+                samples: samples(c, DEFAULT_SPHERE_SAMPLES)?,
+            }
+        }
+        "rect" => {
+            let center = position(c, "position", &l.position)?;
+            let normal = direction(c)?;
+            let v = c.require(&key("size"), &l.size, raw, what)?;
+            let s = c.components(&key("size"), v, 2)?;
+            let size = Vec2::new(s[0], s[1]);
+            if !(size.x > 0.0 && size.y > 0.0 && (size.x * size.y).is_normal()) {
+                return Err(c.range(
+                    &key("size"),
+                    v,
+                    format!(
+                        "width and height must be greater than 0, with an area that fits a \
+                         float (got [{}, {}])",
+                        s[0], s[1]
+                    ),
+                ));
+            }
+            let up = match &l.up {
+                Some(v) => Some((c.vec3(&key("up"), v)?, v)),
+                None => None,
+            };
+            let (right, up_axis) = rect_frame(normal, up.map(|(u, _)| u)).ok_or_else(|| {
+                let (_, v) = up.expect("the default up always has a frame");
+                c.range(
+                    &key("up"),
+                    v,
+                    "must not be zero or parallel to `direction` (the rectangle's height \
+                     runs along up made perpendicular to direction)",
+                )
+            })?;
+            Light::Rect {
+                center,
+                normal,
+                right,
+                up_axis,
+                size,
+                color,
+                intensity: intensity(c)?,
+                samples: samples(c, DEFAULT_RECT_SAMPLES)?,
+            }
+        }
+        _ => {
+            let map = match &l.map {
+                Some(file) => {
+                    let texture = textures.get(c, &key("map"), file, TextureEncoding::Srgb)?;
+                    let map = EnvironmentMap::new(texture).map_err(|why| {
+                        c.at(
+                            SceneErrorKind::Texture,
+                            &key("map"),
+                            file,
+                            format!("environment map {}: {why}", file.get_ref()),
+                        )
+                    })?;
+                    Some(Arc::new(map))
+                }
+                None => None,
+            };
+            let rotation_degrees = match &l.rotation {
+                Some(v) => c.num_where(
+                    &key("rotation"),
+                    v,
+                    |x| x.abs() <= 360.0,
+                    "must be in [-360, 360] degrees",
+                )?,
+                None => 0.0,
+            };
+            Light::Environment {
+                color,
+                intensity: intensity(c)?,
+                map,
+                rotation_degrees,
+                samples: samples(c, DEFAULT_ENVIRONMENT_SAMPLES)?,
             }
         }
     })

@@ -128,7 +128,7 @@ fn build(raw: &RawScene, c: Check, origin: &SceneOrigin) -> Result<Scene, SceneE
         .light
         .iter()
         .enumerate()
-        .map(|(i, l)| build_light(&c, i, l))
+        .map(|(i, l)| build_light(&c, i, l, &mut textures))
         .collect::<Result<Vec<_>, _>>()?;
 
     let translucent_area: f64 = objects

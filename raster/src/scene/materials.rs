@@ -44,7 +44,8 @@ impl<'o> TextureCache<'o> {
         }
     }
 
-    fn get(
+    /// The texture in `file` (reported at `key` when it cannot be read or decoded).
+    pub fn get(
         &mut self,
         c: &Check,
         key: &str,

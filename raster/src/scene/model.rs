@@ -9,6 +9,7 @@ use glam::{Vec2, Vec3};
 use lucent_core::Method;
 
 use crate::camera::Camera;
+use crate::lights::EnvironmentMap;
 use crate::texture::Texture;
 
 /// A complete, validated scene.
@@ -209,6 +210,40 @@ pub enum Light {
         /// Total radiant intensity (as if it were a point light at the centre).
         intensity: f32,
         /// Shadow samples per shading point (≥ 1).
+        samples: u32,
+    },
+    /// A one-sided rectangular Lambertian emitter: soft shadows from `samples` stratified
+    /// points on the rectangle (`docs/physics.md` §5.1).
+    Rect {
+        /// Centre.
+        center: Vec3,
+        /// Unit normal of the emitting face (the light shines where `(p − center)·normal > 0`).
+        normal: Vec3,
+        /// Unit vector along the width, `up_axis × normal` (to the right, seen from the lit side).
+        right: Vec3,
+        /// Unit vector along the height: the scene's `up` made perpendicular to `normal`.
+        up_axis: Vec3,
+        /// Width and height (> 0).
+        size: Vec2,
+        /// Linear RGB colour.
+        color: Vec3,
+        /// Radiant intensity along the normal, I = L · width · height.
+        intensity: f32,
+        /// Shadow samples per shading point (≥ 1).
+        samples: u32,
+    },
+    /// Light from every direction at infinity: a constant radiance, or a lat-long map
+    /// (`docs/physics.md` §5.2).
+    Environment {
+        /// Linear RGB colour: the radiance of a constant environment, a tint on a map.
+        color: Vec3,
+        /// Radiance scale.
+        intensity: f32,
+        /// The lat-long map, if any (`None`: constant radiance `color × intensity`).
+        map: Option<Arc<EnvironmentMap>>,
+        /// Turn of the map about +z, degrees (counter-clockwise seen from above).
+        rotation_degrees: f32,
+        /// Shadow rays per shading point (≥ 1).
         samples: u32,
     },
 }

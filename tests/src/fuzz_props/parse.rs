@@ -10,10 +10,11 @@
 use std::borrow::Cow;
 
 use lucent_core::QuerySettings;
+use lucent_core::glam::Vec3;
 use lucent_raster::raster::MAX_AA;
 use lucent_raster::scene::mesh::validate_mesh;
 use lucent_raster::scene::obj::parse_obj;
-use lucent_raster::scene::{Mesh, SceneOrigin, parse_scene};
+use lucent_raster::scene::{Light, Mesh, SceneOrigin, parse_scene};
 
 /// A small closed mesh (a tetrahedron with UVs and normals) served under the bunny's path, so
 /// that the repository's scenes parse quickly inside the fuzzer.
@@ -26,8 +27,12 @@ f 1/1/1 3/3/3 2/2/2\nf 1/1/1 2/2/2 4/4/4\nf 1/1/1 4/4/4 3/3/3\nf 2/2/2 3/3/3 4/4
 /// The 8-bit grey ramp of `scenes/textured-mfp.toml`.
 const RAMP_PNG: &[u8] = include_bytes!("../../../scenes/textures/mfp-ramp.png");
 
+/// The lat-long sky of `scenes/environment.toml`.
+const SKY_PNG: &[u8] = include_bytes!("../../../scenes/textures/sky-latlong.png");
+
 /// Where fuzzed scenes come from: files served from memory under the names the repository's
-/// scenes use (`../assets/bunny.obj`, `textures/mfp-ramp.png`), plus `mesh.obj`.
+/// scenes use (`../assets/bunny.obj`, `textures/mfp-ramp.png`, `textures/sky-latlong.png`),
+/// plus `mesh.obj`.
 pub fn fuzz_origin() -> SceneOrigin {
     SceneOrigin::Embedded {
         name: "<fuzz>/scene.toml".to_string(),
@@ -41,6 +46,10 @@ pub fn fuzz_origin() -> SceneOrigin {
                 Cow::Borrowed(SMALL_MESH_OBJ.as_bytes()),
             ),
             ("textures/mfp-ramp.png".to_string(), Cow::Borrowed(RAMP_PNG)),
+            (
+                "textures/sky-latlong.png".to_string(),
+                Cow::Borrowed(SKY_PNG),
+            ),
         ],
     }
 }
@@ -102,6 +111,33 @@ pub fn scene_parse_never_panics(data: &[u8]) {
         "render settings {r:?}"
     );
     assert!((1..=MAX_AA).contains(&r.aa), "render settings {r:?}");
+    for light in &scene.lights {
+        match light {
+            Light::Rect {
+                normal,
+                right,
+                up_axis,
+                size,
+                ..
+            } => {
+                let unit = |v: &Vec3| (v.length() - 1.0).abs() < 1e-4;
+                assert!(
+                    unit(normal) && unit(right) && unit(up_axis),
+                    "rect frame {light:?}"
+                );
+                assert!(size.x > 0.0 && size.y > 0.0, "rect size {light:?}");
+            }
+            Light::Environment {
+                map: Some(map),
+                intensity,
+                ..
+            } => {
+                assert_eq!(map.validate(), Ok(()), "environment map");
+                assert!(intensity.is_finite() && *intensity >= 0.0);
+            }
+            _ => {}
+        }
+    }
 }
 
 /// The property of the fuzz target `obj_load_never_panics`: `parse_obj` returns a value or an

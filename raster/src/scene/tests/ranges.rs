@@ -3,6 +3,7 @@
 use super::*;
 
 use SceneErrorKind::OutOfRange as R;
+use glam::Vec3;
 
 #[test]
 fn camera_values() {
@@ -114,6 +115,118 @@ fn light_values() {
         sphere("radius = 0") => "radius = 0", "light[0].radius", "greater than 0";
         sphere("radius = 1\nsamples = 0") => "samples", "light[0].samples", "1..=4096";
         directional => "irradiance", "light[0].irradiance", "at least 0";
+    }
+}
+
+/// The rect light `extra` lines (a complete one unless they say otherwise), in place of the
+/// point light.
+fn rect(extra: &str) -> String {
+    edit(
+        "type = \"point\"",
+        &format!("type = 'rect'\ndirection = [0, 0, -1]\n{extra}"),
+    )
+}
+
+/// An environment light with `extra` lines, in place of the point light.
+fn environment(extra: &str) -> String {
+    edit(
+        "type = \"point\"\nposition = [0, -3, 5]\nintensity = 20",
+        &format!("type = 'environment'\n{extra}"),
+    )
+}
+
+#[test]
+fn rect_and_environment_values() {
+    expect_all! { R;
+        rect("size = [1, 0]") => "size", "light[0].size", "greater than 0";
+        rect("size = [-1, 2]") => "size", "light[0].size", "greater than 0";
+        rect("size = 0") => "size", "light[0].size", "greater than 0";
+        // Each side is a float, the area underflows: a zero-area rectangle.
+        rect("size = [1e-30, 1e-30]") => "size", "light[0].size", "area";
+        rect("size = [1, nan]") => "size", "light[0].size", "finite";
+        rect("size = [1, 1]\nup = [0, 0, 2]") => "up", "light[0].up", "parallel to `direction`";
+        rect("size = [1, 1]\nup = [0, 0, 0]") => "up", "light[0].up", "zero";
+        rect("size = [1, 1]\nsamples = 5000") => "samples", "light[0].samples", "1..=4096";
+        edit("intensity = 20", "intensity = -3").replace("type = \"point\"", "type = 'rect'\ndirection = [0, 0, -1]\nsize = 1")
+            => "intensity", "light[0].intensity", "at least 0";
+        edit("intensity = 20", "intensity = nan").replace("type = \"point\"", "type = 'rect'\ndirection = [0, 0, -1]\nsize = 1")
+            => "intensity", "light[0].intensity", "finite";
+        environment("intensity = -1") => "intensity", "light[0].intensity", "at least 0";
+        environment("intensity = nan") => "intensity", "light[0].intensity", "finite";
+        environment("intensity = 1\ncolor = [1, -0.5, 1]") => "color", "light[0].color", "at least 0";
+        environment("intensity = 1\nrotation = inf") => "rotation", "light[0].rotation", "finite";
+        environment("intensity = 1\nrotation = 400") => "rotation", "light[0].rotation", "[-360, 360]";
+        environment("intensity = 1\nsamples = 0") => "samples", "light[0].samples", "1..=4096";
+    }
+    expect_all! { SceneErrorKind::WrongType;
+        rect("size = [1, 2, 3]") => "size", "light[0].size", "array of 2 numbers";
+    }
+    expect_all! { SceneErrorKind::MissingKey;
+        rect("") => "[[light]]", "light[0].size", "a rect light";
+        environment("map = 'ramp.png'") => "[[light]]", "light[0].intensity", "an environment light";
+    }
+    expect_all! { SceneErrorKind::Conflict;
+        rect("size = 1\nradius = 2") => "radius = 2", "light[0].radius", "a rect light";
+        environment("intensity = 1\nposition = [0, 0, 1]") => "position = [0, 0, 1]", "light[0].position", "an environment light";
+        environment("intensity = 1\nsize = [1, 1]") => "size = [1, 1]", "light[0].size", "an environment light";
+        edit("intensity = 20", "intensity = 20\nmap = 'ramp.png'") => "map", "light[0].map", "a point light";
+    }
+    expect_all! { SceneErrorKind::Io;
+        environment("intensity = 1\nmap = 'nothere.png'") => "nothere.png", "light[0].map", "cannot read texture";
+    }
+    expect_all! { SceneErrorKind::Texture;
+        environment("intensity = 1\nmap = 'bad.png'") => "bad.png", "light[0].map", "bad.png";
+    }
+}
+
+#[test]
+fn rect_and_environment_lights_load() {
+    let s = load(&rect("size = [2, 0.5]\nsamples = 9")).unwrap();
+    match &s.lights[..] {
+        [
+            Light::Rect {
+                center,
+                normal,
+                right,
+                up_axis,
+                size,
+                intensity,
+                samples,
+                ..
+            },
+        ] => {
+            assert_eq!(*center, Vec3::new(0.0, -3.0, 5.0));
+            assert_eq!(*normal, -Vec3::Z);
+            // Facing straight down: height along +y, width along y × (−z) = −x.
+            assert_eq!((*up_axis, *right), (Vec3::Y, -Vec3::X));
+            assert_eq!(*size, glam::Vec2::new(2.0, 0.5));
+            assert_eq!((*intensity, *samples), (20.0, 9));
+        }
+        other => panic!("{other:?}"),
+    }
+    let s = load(&environment("intensity = 0.5\ncolor = [1, 0.5, 0.25]")).unwrap();
+    assert!(matches!(
+        &s.lights[..],
+        [Light::Environment { map: None, samples: 64, rotation_degrees: 0.0, intensity: 0.5, color, .. }]
+            if *color == Vec3::new(1.0, 0.5, 0.25)
+    ));
+    let s = load(&environment(
+        "intensity = 2\nmap = 'ramp.png'\nrotation = -90",
+    ))
+    .unwrap();
+    match &s.lights[..] {
+        [
+            Light::Environment {
+                map: Some(map),
+                rotation_degrees,
+                ..
+            },
+        ] => {
+            assert_eq!(*rotation_degrees, -90.0);
+            assert_eq!((map.texture().width, map.texture().height), (8, 1));
+            assert_eq!(map.validate(), Ok(()));
+        }
+        other => panic!("{other:?}"),
     }
 }
 
