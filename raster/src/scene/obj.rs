@@ -213,16 +213,18 @@ fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh
         if base + count > u32::MAX as usize {
             return Err(fail("too many vertices".to_string()));
         }
-        let group = match m.material_id.and_then(|id| materials.get(id)) {
-            None => None,
-            Some(material) => Some(match groups.iter().position(|g| *g == material.name) {
-                Some(i) => i as u32,
-                None => {
-                    groups.push(material.name.clone());
-                    (groups.len() - 1) as u32
-                }
-            }),
-        };
+        let group = m
+            .material_id
+            .and_then(|id| materials.get(id))
+            .map(
+                |material| match groups.iter().position(|g| *g == material.name) {
+                    Some(i) => i as u32,
+                    None => {
+                        groups.push(material.name.clone());
+                        (groups.len() - 1) as u32
+                    }
+                },
+            );
         mesh.positions.extend(
             m.positions
                 .chunks_exact(3)

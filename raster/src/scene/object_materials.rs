@@ -306,7 +306,7 @@ pub(crate) fn split_by_material(
     }
     used.iter()
         .map(|&m| {
-            let part = Mesh {
+            let mut part = Mesh {
                 positions: mesh.positions.clone(),
                 normals: mesh.normals.clone(),
                 uvs: mesh.uvs.clone(),
@@ -318,7 +318,6 @@ pub(crate) fn split_by_material(
                     .map(|(t, _)| *t)
                     .collect(),
             };
-            let mut part = part;
             drop_unused_vertices(&mut part);
             let part_name = format!("{name}/{}", table.name_of(m));
             validate_mesh(&part).map_err(|why| {

@@ -39,6 +39,10 @@ pub fn position_ids(positions: &[Vec3]) -> Vec<u32> {
         .collect()
 }
 
+/// A triangle using a welded edge: (triangle, its corner at the edge's smaller position id,
+/// its corner at the larger one).
+type EdgeUse = (u32, u32, u32);
+
 /// Union–find over corners, with path halving.
 struct Fans(Vec<u32>);
 
@@ -77,7 +81,7 @@ pub fn weld_normals(mesh: &mut Mesh, crease_degrees: f32) {
     let units: Vec<Option<Vec3>> = faces.iter().map(|n| n.try_normalize()).collect();
 
     // Welded edges (smaller id first) → the corners at each end, per triangle using it.
-    let mut edges: HashMap<(u32, u32), Vec<(u32, u32, u32)>> = HashMap::new();
+    let mut edges: HashMap<(u32, u32), Vec<EdgeUse>> = HashMap::new();
     for (f, t) in mesh.triangles.iter().enumerate() {
         for k in 0..3 {
             let (ka, kb) = (k, (k + 1) % 3);

@@ -12,7 +12,9 @@ use std::borrow::Cow;
 use lucent_core::QuerySettings;
 use lucent_raster::raster::MAX_AA;
 use lucent_raster::scene::mesh::validate_mesh;
-use lucent_raster::scene::obj::parse_obj;
+use lucent_raster::scene::mtl::parse_mtl;
+use lucent_raster::scene::obj::load_obj;
+use lucent_raster::scene::weld::weld_normals;
 use lucent_raster::scene::{Mesh, SceneOrigin, parse_scene};
 
 /// A small closed mesh (a tetrahedron with UVs and normals) served under the bunny's path, so
@@ -26,9 +28,30 @@ f 1/1/1 3/3/3 2/2/2\nf 1/1/1 2/2/2 4/4/4\nf 1/1/1 4/4/4 3/3/3\nf 2/2/2 3/3/3 4/4
 /// The 8-bit grey ramp of `scenes/textured-mfp.toml`.
 const RAMP_PNG: &[u8] = include_bytes!("../../../scenes/textures/mfp-ramp.png");
 
+/// The two-material OBJ of `scenes/obj-materials.toml`, its `.mtl` and its `map_Kd`.
+const TWO_MATERIALS: [(&str, &[u8]); 3] = [
+    (
+        "meshes/two-materials.obj",
+        include_bytes!("../../../scenes/meshes/two-materials.obj"),
+    ),
+    (
+        "meshes/two-materials.mtl",
+        include_bytes!("../../../scenes/meshes/two-materials.mtl"),
+    ),
+    (
+        "meshes/two-materials-kd.png",
+        include_bytes!("../../../scenes/meshes/two-materials-kd.png"),
+    ),
+];
+
 /// Where fuzzed scenes come from: files served from memory under the names the repository's
-/// scenes use (`../assets/bunny.obj`, `textures/mfp-ramp.png`), plus `mesh.obj`.
+/// scenes use (`../assets/bunny.obj`, `textures/mfp-ramp.png`, `meshes/two-materials.*`), plus
+/// `mesh.obj`.
 pub fn fuzz_origin() -> SceneOrigin {
+    let mut files = TWO_MATERIALS
+        .iter()
+        .map(|&(name, bytes)| (name.to_string(), Cow::Borrowed(bytes)))
+        .collect::<Vec<_>>();
     SceneOrigin::Embedded {
         name: "<fuzz>/scene.toml".to_string(),
         files: vec![
@@ -41,7 +64,10 @@ pub fn fuzz_origin() -> SceneOrigin {
                 Cow::Borrowed(SMALL_MESH_OBJ.as_bytes()),
             ),
             ("textures/mfp-ramp.png".to_string(), Cow::Borrowed(RAMP_PNG)),
-        ],
+        ]
+        .into_iter()
+        .chain(files.drain(..))
+        .collect(),
     }
 }
 
@@ -104,10 +130,25 @@ pub fn scene_parse_never_panics(data: &[u8]) {
     assert!((1..=MAX_AA).contains(&r.aa), "render settings {r:?}");
 }
 
-/// The property of the fuzz target `obj_load_never_panics`: `parse_obj` returns a value or an
-/// error, and a value is a valid mesh. Panics when that fails.
+/// The property of the fuzz target `obj_load_never_panics`: `load_obj` returns a value or an
+/// error, and a value is a valid mesh whose every triangle has a group in range; welding it
+/// (at a 60° crease) keeps it valid with the same triangles. The same bytes read as a `.mtl`
+/// give materials or an error. Panics when that fails.
 pub fn obj_load_never_panics(data: &[u8]) {
-    if let Ok(mesh) = parse_obj(data) {
-        check_mesh("parse_obj", &mesh);
+    if let Ok(obj) = load_obj(data) {
+        check_mesh("load_obj", &obj.mesh);
+        assert_eq!(obj.triangle_groups.len(), obj.mesh.triangles.len());
+        assert!(
+            obj.triangle_groups
+                .iter()
+                .flatten()
+                .all(|&g| (g as usize) < obj.groups.len()),
+            "group out of range"
+        );
+        let mut welded = obj.mesh.clone();
+        weld_normals(&mut welded, 60.0);
+        check_mesh("weld_normals", &welded);
+        assert_eq!(welded.triangles.len(), obj.mesh.triangles.len());
     }
+    let _ = parse_mtl(data);
 }
