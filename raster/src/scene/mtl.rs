@@ -16,20 +16,30 @@ pub struct MtlMaterial {
 }
 
 /// Parses a `.mtl` file held in memory. Bytes that are not UTF-8 are accepted in comments
-/// only. A `map_Kd` with options (`-s`, `-o`, `-clamp`, ...) is an error: lucent would ignore
+/// only. A colour (`Ka`, `Kd`, `Ks`, `Ke`) needs three numbers. A `map_Kd` with options (`-s`, `-o`, `-clamp`, ...) is an error: lucent would ignore
 /// them and map the texture differently from the file's intent.
 pub fn parse_mtl(bytes: &[u8]) -> Result<Vec<MtlMaterial>, ObjError> {
     let text = utf8_lines(bytes, &[])?;
     for (number, line) in text.lines().enumerate() {
+        let fail = |message: String| ObjError {
+            line: Some(number + 1),
+            message,
+            source: None,
+        };
         let mut words = line.split_whitespace();
-        if words.next() == Some("map_Kd") && words.next().is_some_and(|w| w.starts_with('-')) {
-            return Err(ObjError {
-                line: Some(number + 1),
-                message: "map_Kd options (-s, -o, -clamp, ...) are not supported: give only \
-                          the texture file"
-                    .to_string(),
-                source: None,
-            });
+        match words.next() {
+            Some("map_Kd") if words.next().is_some_and(|w| w.starts_with('-')) => {
+                return Err(fail(
+                    "map_Kd options (-s, -o, -clamp, ...) are not supported: give only the \
+                     texture file"
+                        .to_string(),
+                ));
+            }
+            // `tobj` panics on a colour with fewer than three numbers.
+            Some(colour @ ("Ka" | "Kd" | "Ks" | "Ke")) if words.clone().count() < 3 => {
+                return Err(fail(format!("{colour} needs three numbers (r g b)")));
+            }
+            _ => {}
         }
     }
     let mut reader = BufReader::new(text.as_bytes());
@@ -81,5 +91,9 @@ mod tests {
         assert!(e.message.contains("UTF-8"), "{e}");
         let e = parse_mtl(b"newmtl a\nKd x y z\n").unwrap_err();
         assert!(e.message.contains("malformed MTL"), "{e}");
+        // Found by fuzzing: two numbers made `tobj` panic.
+        let e = parse_mtl(b"newmtl a\nKd 0 1\n").unwrap_err();
+        assert_eq!(e.line, Some(2));
+        assert!(e.message.contains("three numbers"), "{e}");
     }
 }
