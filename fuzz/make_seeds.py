@@ -165,7 +165,8 @@ def table_seeds():
 # ------------------------------------------------------------------------ scene_parse_never_panics
 def scene_seeds():
     t = "scene_parse_never_panics"
-    for name in ("default", "sphere-shadow", "textured-mfp", "rect-light", "environment"):
+    for name in ("default", "sphere-shadow", "textured-mfp", "rect-light", "environment",
+                 "obj-materials"):
         with open(os.path.join(ROOT, "scenes", name + ".toml"), "rb") as f:
             write(t, name + ".toml", f.read())
     every = b"""
@@ -283,6 +284,13 @@ def obj_seeds():
     write(t, "bad-index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")
     write(t, "degenerate.obj", b"v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n")
     write(t, "huge-numbers.obj", b"v 1e38 0 0\nv 0 1e38 0\nv 0 0 1e38\nf 1 2 3\nv nan 0 0\n")
+    with open(os.path.join(ROOT, "scenes", "meshes", "two-materials.mtl"), "rb") as f:
+        write(t, "two-materials.mtl", f.read())
+    write(t, "groups-latin1.obj", b"# caf\xe9\nmtllib lib.mtl\no t\xeate\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+          b"  usemtl skin\nf 1 3 2\nusemtl lens glass\nf 1 2 4\nusemtl skin\nf 1 4 3\nf 2 3 4\n")
+    write(t, "inside-out-tetra.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nvn 0 1 0\nvn 1 0 0\nvn 1 1 1\n"
+          b"f 1//1 2//1 3//1\nf 1//2 4//2 2//2\nf 1//3 3//3 4//3\nf 2//4 4//4 3//4\n")
+    write(t, "mtl-options.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd -s 1 1 1 a.png\nnewmtl b\nmap_Kd b c.png\n")
 
 
 # ----------------------------------------------------------------------- raster_triangle_in_bounds

@@ -17,12 +17,17 @@ use crate::scene::{
     load_scene,
 };
 
-/// Loads the scene named on the command line, or the built-in default.
+/// Loads the scene named on the command line, or the built-in default, printing its
+/// warnings on stderr.
 fn load(path: Option<&Path>) -> Result<Scene, String> {
-    match path {
-        Some(p) => load_scene(p).map_err(|e| e.to_string()),
-        None => Ok(default_scene()),
+    let scene = match path {
+        Some(p) => load_scene(p).map_err(|e| e.to_string())?,
+        None => default_scene(),
+    };
+    for warning in &scene.warnings {
+        eprintln!("warning: {warning}");
     }
+    Ok(scene)
 }
 
 fn check(ok: bool, flag: &str, value: impl std::fmt::Display, range: &str) -> Result<(), String> {

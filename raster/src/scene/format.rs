@@ -65,6 +65,9 @@ pub(crate) struct RawObject {
     pub rotate: Option<Vec3Raw>,
     pub scale: Option<Num>,
     pub material: Str,
+    pub materials: Option<Spanned<BTreeMap<String, Str>>>,
+    pub weld: Option<Spanned<bool>>,
+    pub crease_angle: Option<Num>,
 }
 
 /// One `[material.NAME]`: the union of the keys of every material type; which keys apply is
@@ -248,6 +251,8 @@ pub(crate) enum RawParam {
     Constant(Components),
     /// A texture lookup.
     Texture(RawTextureRef),
+    /// A word (only `kd = "mtl"` is valid; checked when building).
+    Word(String),
 }
 
 impl<'de> Deserialize<'de> for RawParam {
@@ -263,6 +268,10 @@ impl<'de> Visitor<'de> for ParamVisitor {
 
     fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str("a number, an array [r, g, b] or a table { texture = \"file.png\" }")
+    }
+
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawParam, E> {
+        Ok(RawParam::Word(v.to_string()))
     }
 
     fn visit_f64<E: de::Error>(self, v: f64) -> Result<RawParam, E> {

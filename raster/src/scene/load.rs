@@ -16,7 +16,8 @@ use super::lights::build_light;
 use super::materials::{TextureCache, build_material};
 use super::mesh::mesh_area;
 use super::model::{Material, Scene};
-use super::objects::{MaterialRef, build_object};
+use super::object_materials::{MaterialRef, MaterialTable};
+use super::objects::build_object;
 use super::origin::{SceneOrigin, read_limited};
 use super::settings::{build_camera, build_output, build_render};
 
@@ -82,11 +83,11 @@ fn build(raw: &RawScene, c: Check, origin: &SceneOrigin) -> Result<Scene, SceneE
     // Materials, in name order (the file's tables are a map).
     let mut textures = TextureCache::new(origin);
     let mut materials = Vec::with_capacity(raw.material.len());
-    let mut texture_keys = Vec::with_capacity(raw.material.len());
+    let mut refs = Vec::with_capacity(raw.material.len());
     for (name, table) in &raw.material {
         let built = build_material(&c, name, table, &mut textures)?;
         materials.push(built.material);
-        texture_keys.push(built.texture_key);
+        refs.push((built.texture_key, built.kd_from_mtl));
     }
     let by_name: HashMap<&str, MaterialRef> = raw
         .material
@@ -97,7 +98,8 @@ fn build(raw: &RawScene, c: Check, origin: &SceneOrigin) -> Result<Scene, SceneE
                 name.as_str(),
                 MaterialRef {
                     index,
-                    texture_key: texture_keys[index],
+                    texture_key: refs[index].0,
+                    kd_from_mtl: refs[index].1,
                 },
             )
         })
@@ -110,12 +112,17 @@ fn build(raw: &RawScene, c: Check, origin: &SceneOrigin) -> Result<Scene, SceneE
             "the scene has no [[object]]",
         ));
     }
-    let objects = raw
-        .object
-        .iter()
-        .enumerate()
-        .map(|(i, o)| build_object(&c, i, o, origin, &by_name))
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut table = MaterialTable::new(by_name, materials, textures);
+    let mut objects = Vec::with_capacity(raw.object.len());
+    for (i, o) in raw.object.iter().enumerate() {
+        objects.extend(build_object(&c, i, o, origin, &mut table)?);
+    }
+    let MaterialTable {
+        materials,
+        warnings,
+        mut textures,
+        ..
+    } = table;
 
     if raw.light.is_empty() {
         return Err(c.src.file_error(
@@ -147,5 +154,6 @@ fn build(raw: &RawScene, c: Check, origin: &SceneOrigin) -> Result<Scene, SceneE
         render,
         output,
         source: origin.source_path(),
+        warnings,
     })
 }

@@ -44,7 +44,8 @@ impl<'o> TextureCache<'o> {
         }
     }
 
-    /// The texture in `file` (reported at `key` when it cannot be read or decoded).
+    /// The texture in `file` (relative to the scene), decoded with `encoding`; errors are
+    /// located at `file`'s span under `key`.
     pub fn get(
         &mut self,
         c: &Check,
@@ -81,6 +82,24 @@ impl<'o> TextureCache<'o> {
 pub(crate) struct BuiltMaterial {
     pub material: Material,
     pub texture_key: Option<&'static str>,
+    /// `kd = "mtl"`: each object using it supplies K_d from its OBJ's `map_Kd` (the material
+    /// holds a placeholder constant until [`with_kd_texture`] replaces it).
+    pub kd_from_mtl: bool,
+}
+
+/// The K_d every `kd = "mtl"` material holds until an object supplies its `map_Kd`.
+const MTL_PLACEHOLDER_KD: f32 = 0.5;
+
+/// A copy of a `kd = "mtl"` material with K_d from `texture`, named after both.
+pub(crate) fn with_kd_texture(material: &Material, texture: Arc<Texture>, file: &str) -> Material {
+    let mut m = material.clone();
+    if let Material::Translucent(t) = &mut m {
+        t.name = format!("{} (map_Kd {file})", t.name);
+        if let Medium::Reflectance { kd, .. } = &mut t.medium {
+            *kd = ColorParam::Texture(texture);
+        }
+    }
+    m
 }
 
 /// Builds one material from its table.
@@ -121,11 +140,12 @@ pub(crate) fn build_material(
                     albedo,
                 },
                 texture_key: None,
+                kd_from_mtl: false,
             })
         }
         "translucent" => {
             c.forbid(&key("albedo"), &m.albedo, "a translucent material (use kd)")?;
-            let (medium, texture_key) = build_medium(c, name, raw, textures)?;
+            let (medium, texture_key, kd_from_mtl) = build_medium(c, name, raw, textures)?;
             let specular = match &m.specular {
                 None => None,
                 Some(s) => {
@@ -146,6 +166,7 @@ pub(crate) fn build_material(
                     specular,
                 }),
                 texture_key,
+                kd_from_mtl,
             })
         }
         other => Err(c.at(
@@ -160,13 +181,14 @@ pub(crate) fn build_material(
     }
 }
 
-/// The three ways of giving a medium; exactly one must be used.
+/// The three ways of giving a medium; exactly one must be used. Also returns the first
+/// textured key and whether K_d comes from the OBJ's `.mtl` (`kd = "mtl"`).
 fn build_medium(
     c: &Check,
     name: &str,
     raw: &Spanned<RawMaterial>,
     textures: &mut TextureCache,
-) -> Checked<(Medium, Option<&'static str>)> {
+) -> Checked<(Medium, Option<&'static str>, bool)> {
     let m = raw.get_ref();
     let key = |k: &str| format!("material.{name}.{k}");
     const FORMS: &str = "a translucent material takes exactly one of: `preset` + `mm_per_unit`; \
@@ -255,7 +277,7 @@ fn build_medium(
             name: preset.get_ref().to_ascii_lowercase(),
             mm_per_unit,
         };
-        return Ok((medium, None));
+        return Ok((medium, None, false));
     }
     if m.sigma_a.is_some() || m.sigma_s_prime.is_some() {
         let what = "explicit coefficients";
@@ -287,12 +309,17 @@ fn build_medium(
             sigma_s_prime,
             eta,
         };
-        return Ok((medium, None));
+        return Ok((medium, None, false));
     }
     let what = "kd and a mean free path";
     c.forbid(&key("mm_per_unit"), &m.mm_per_unit, what)?;
     let kd_raw = c.require(&key("kd"), &m.kd, raw, what)?;
-    let kd = color_param(c, &key("kd"), kd_raw, textures)?;
+    let kd_from_mtl = matches!(kd_raw.get_ref(), RawParam::Word(w) if w == "mtl");
+    let kd = if kd_from_mtl {
+        ColorParam::Constant(glam::Vec3::splat(MTL_PLACEHOLDER_KD))
+    } else {
+        color_param(c, &key("kd"), kd_raw, textures)?
+    };
     let distance = match (&m.mean_free_path, &m.diffuse_mean_free_path) {
         (Some(_), Some(d)) => {
             return Err(c.at(
@@ -341,7 +368,7 @@ fn build_medium(
         ));
     }
     let textured = [
-        matches!(kd, ColorParam::Texture(_)).then_some("kd"),
+        (kd_from_mtl || matches!(kd, ColorParam::Texture(_))).then_some("kd"),
         match &distance {
             Distance::MeanFreePath(ScalarParam::Texture { .. }) => Some("mean_free_path"),
             Distance::DiffuseMeanFreePath(ScalarParam::Texture { .. }) => {
@@ -353,6 +380,7 @@ fn build_medium(
     Ok((
         Medium::Reflectance { kd, distance, eta },
         textured.into_iter().flatten().next(),
+        kd_from_mtl,
     ))
 }
 
@@ -375,7 +403,8 @@ fn eta(
     )
 }
 
-/// K_d: `[r, g, b]` / a number in (0, 1), or `{ texture = "file.png" }` (sRGB-decoded).
+/// K_d: `[r, g, b]` / a number in (0, 1), or `{ texture = "file.png" }` (sRGB-decoded);
+/// `"mtl"` is handled by the caller.
 fn color_param(
     c: &Check,
     key: &str,
@@ -403,6 +432,15 @@ fn color_param(
             )?;
             Ok(ColorParam::Texture(texture))
         }
+        RawParam::Word(w) => Err(c.at(
+            SceneErrorKind::WrongType,
+            key,
+            v,
+            format!(
+                "invalid value `{w}`: expected a number, an array [r, g, b], a table \
+                 {{ texture = \"file.png\" }} or \"mtl\" (the OBJ's map_Kd)"
+            ),
+        )),
     }
 }
 
@@ -440,6 +478,15 @@ fn distance_param(
             )?;
             Ok(ScalarParam::Texture { texture, min, max })
         }
+        RawParam::Word(w) => Err(c.at(
+            SceneErrorKind::WrongType,
+            key,
+            v,
+            format!(
+                "invalid value `{w}`: expected a number, an array [r, g, b] or a table \
+                 {{ texture, min, max }} (only `kd` may be \"mtl\")"
+            ),
+        )),
     }
 }
 

@@ -140,6 +140,15 @@ fn keep<T: Copy>(v: &[T], used: &[bool]) -> Vec<T> {
         .collect()
 }
 
+/// The largest accepted coordinate magnitude (scene units), in object and world space.
+///
+/// The renderer works in f32 and sums squared lengths and areas: with every coordinate within
+/// ±10¹², a squared distance across the scene is at most 1.2·10²⁵ and a sum of 2³² such terms
+/// stays below 10³⁵, well under f32's 3.4·10³⁸. Beyond it areas and densities overflow (a
+/// tetrahedron at ±6·10³⁷ used to reach the sampler with an infinite area and a sample cap
+/// of millions), and no sensible unit needs it: 10¹² m is seven times the Earth–Sun distance.
+pub const MAX_COORDINATE: f32 = 1e12;
+
 /// Checks every invariant documented on [`Mesh`]; the error says which one failed.
 pub fn validate_mesh(mesh: &Mesh) -> Result<(), String> {
     let n = mesh.positions.len();
@@ -159,6 +168,18 @@ pub fn validate_mesh(mesh: &Mesh) -> Result<(), String> {
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(format!(
             "vertex {} has a non-finite position {:?}",
+            i + 1,
+            mesh.positions[i]
+        ));
+    }
+    if let Some(i) = mesh
+        .positions
+        .iter()
+        .position(|p| p.abs().max_element() > MAX_COORDINATE)
+    {
+        return Err(format!(
+            "vertex {} at {:?} is farther than {MAX_COORDINATE:e} units from the origin on \
+             some axis (check the file's units and the object's scale)",
             i + 1,
             mesh.positions[i]
         ));

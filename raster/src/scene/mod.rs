@@ -2,8 +2,8 @@
 //!
 //! The format is documented in `docs/scene-format.md`. Loading goes text → serde structures
 //! mirroring the tables (`format.rs`; unknown keys and wrong types rejected) → value checks,
-//! name resolution and file loading (`settings.rs`, `objects.rs`, `materials.rs`,
-//! `lights.rs`) → [`Scene`] (the shared, validated data model of `model.rs`). Every failure is a
+//! name resolution and file loading (`settings.rs`, `objects.rs`, `object_materials.rs`,
+//! `materials.rs`, `lights.rs`) → [`Scene`] (the shared, validated data model of `model.rs`). Every failure is a
 //! [`SceneError`] naming the file, line, column and key. Files are read through a
 //! [`SceneOrigin`], so the built-in [`default_scene`] loads from memory.
 //!
@@ -23,11 +23,15 @@ mod load;
 mod materials;
 pub mod mesh;
 mod model;
+pub mod mtl;
 pub mod obj;
+mod object_materials;
 mod objects;
 mod origin;
+pub mod sanity;
 mod settings;
 pub mod shapes;
+pub mod weld;
 
 #[cfg(test)]
 mod tests;

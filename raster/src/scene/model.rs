@@ -17,7 +17,8 @@ use crate::texture::Texture;
 pub struct Scene {
     /// The camera.
     pub camera: Camera,
-    /// Every object, each a world-space triangle mesh with one material.
+    /// Every object, each a world-space triangle mesh with one material (an OBJ file whose
+    /// `usemtl` groups map to several materials becomes one object per material).
     pub objects: Vec<Object>,
     /// Materials, referenced by [`Object::material`].
     pub materials: Vec<Material>,
@@ -29,6 +30,10 @@ pub struct Scene {
     pub output: OutputSettings,
     /// The file the scene came from (`None` for the built-in default scene).
     pub source: Option<PathBuf>,
+    /// What loading repaired or doubted without failing (a mesh flipped outside out, an OBJ
+    /// material group the scene does not map, ...), each located like a
+    /// [`SceneError`](super::SceneError). The command line prints them on stderr.
+    pub warnings: Vec<String>,
 }
 
 /// One mesh with one material.
@@ -45,7 +50,7 @@ pub struct Object {
 /// An indexed triangle mesh in world space.
 ///
 /// Invariants (checked by the loader): every index is in range, every position, normal and UV
-/// is finite, normals have unit length, `uvs` (when present) has one entry per vertex, and the
+/// is finite, every coordinate is within ±[`MAX_COORDINATE`](super::mesh::MAX_COORDINATE), normals have unit length, `uvs` (when present) has one entry per vertex, and the
 /// total area is positive.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {

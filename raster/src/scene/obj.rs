@@ -4,10 +4,14 @@
 //! Before `tobj` sees a file, a cheap pass checks every face index against the number of
 //! vertices, texture coordinates and normals defined so far (negative, relative indices) or in
 //! the whole file (positive indices). That gives errors with OBJ line numbers, and keeps
-//! absurd indices (which overflow inside `tobj`'s index arithmetic) away from it. Materials
-//! (`mtllib`, `usemtl`) are ignored: the scene assigns the material. Normals are kept when every
-//! vertex has one, else computed (area-weighted); UVs are kept when every vertex has them.
+//! absurd indices (which overflow inside `tobj`'s index arithmetic) away from it. Each
+//! triangle remembers its `usemtl` group and the `mtllib` paths are kept: the scene maps groups
+//! to its materials and may take `map_Kd` from the libraries (`objects.rs`, `mtl.rs`). Normals
+//! are kept when every vertex has one, else computed (area-weighted); UVs are kept when every
+//! vertex has them. A closed mesh wound inside out is flipped, and file normals against the
+//! winding are reported (`sanity.rs`).
 
+use std::borrow::Cow;
 use std::fmt;
 use std::io::BufReader;
 
@@ -15,6 +19,7 @@ use glam::{Vec2, Vec3};
 
 use super::mesh::{drop_unused_vertices, smooth_normals, validate_mesh};
 use super::model::Mesh;
+use super::sanity::{normals_against_winding, orient_outward};
 
 /// Why an OBJ file could not be used.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,41 +50,151 @@ impl std::error::Error for ObjError {
     }
 }
 
+/// An OBJ file as loaded: the merged mesh plus what the scene may refine it with.
+#[derive(Clone, Debug, Default)]
+pub struct ObjMesh {
+    /// Every face of the file, in its own (object) coordinates.
+    pub mesh: Mesh,
+    /// The `usemtl` names, in order of first use by a face.
+    pub groups: Vec<String>,
+    /// Per triangle of `mesh`: index into `groups`, or `None` for faces before any `usemtl`.
+    pub triangle_groups: Vec<Option<u32>>,
+    /// The `mtllib` statements: (1-based OBJ line, path relative to the OBJ file).
+    pub mtllibs: Vec<(usize, String)>,
+    /// Repairs made and doubts about the file (see `sanity.rs`), one sentence each.
+    pub warnings: Vec<String>,
+}
+
 /// Parses an OBJ file held in memory into one mesh in its own (object) coordinates.
 pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1;
-        ObjError {
-            line: Some(line),
-            message: "not UTF-8 text".to_string(),
-            source: None,
+    load_obj(bytes).map(|obj| obj.mesh)
+}
+
+/// The `mtllib` name under which the `usemtl` names are handed to `tobj` (see [`load_obj`]).
+/// It starts with a control character, so no real file is called that.
+const GROUP_LIBRARY: &str = "\u{1}lucent-usemtl-names";
+
+/// Parses an OBJ file held in memory, keeping its `usemtl` groups and `mtllib` statements.
+///
+/// `tobj` only reports a face's material when a loaded `.mtl` defines it, so the material
+/// libraries are not read here: instead every `usemtl` name found in the text is handed to
+/// `tobj` as one synthetic library, and each of its models then names its group. Reading the
+/// `.mtl` files is left to the scene, which knows whether it needs them (`kd = "mtl"`).
+///
+/// Bytes that are not UTF-8 are accepted in comments and in `o`, `g` and `s` statements
+/// (replaced by U+FFFD; lucent does not use those names) and rejected with their line anywhere
+/// else, where they would change a number, an index or a name that must match.
+pub fn load_obj(bytes: &[u8]) -> Result<ObjMesh, ObjError> {
+    let text = utf8_lines(bytes, &["o", "g", "s"])?;
+    check_indices(&text)?;
+    // `tobj` takes a statement's argument as the line after its first space, so an indented
+    // `usemtl x` would name the group "usemtl x": statements start at their first word here.
+    let mut with_groups = format!("mtllib {GROUP_LIBRARY}\n");
+    for line in text.lines() {
+        with_groups.push_str(line.trim_start());
+        with_groups.push('\n');
+    }
+    let text = &with_groups[with_groups.find('\n').map_or(0, |i| i + 1)..];
+    let mut groups_in_text: Vec<String> = Vec::new();
+    let mut mtllibs = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        // The same split as `tobj`'s (the rest of the line after the first space, trimmed).
+        match line.split_whitespace().next() {
+            Some("usemtl") => {
+                let name = line.split_once(' ').unwrap_or_default().1.trim();
+                if !name.is_empty() && !groups_in_text.iter().any(|g| g == name) {
+                    groups_in_text.push(name.to_string());
+                }
+            }
+            Some("mtllib") => {
+                let path = line.split_once(' ').unwrap_or_default().1.trim();
+                if !path.is_empty() {
+                    mtllibs.push((number + 1, path.to_string()));
+                }
+            }
+            _ => {}
         }
-    })?;
-    check_indices(text)?;
+    }
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader = BufReader::new(text.as_bytes());
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
+    let mut reader = BufReader::new(with_groups.as_bytes());
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |path| {
+        if path == std::path::Path::new(GROUP_LIBRARY) {
+            let library = groups_in_text
+                .iter()
+                .map(|name| tobj::Material {
+                    name: name.clone(),
+                    ..Default::default()
+                })
+                .collect::<Vec<_>>();
+            let index = groups_in_text
+                .iter()
+                .enumerate()
+                .map(|(i, name)| (name.clone(), i))
+                .collect();
+            Ok((library, index))
+        } else {
+            Ok((Vec::new(), Default::default()))
+        }
     })
     .map_err(|e| ObjError {
         line: None,
         message: format!("malformed OBJ: {e}"),
         source: Some(e),
     })?;
-    merge(&models)
+    let materials = materials.unwrap_or_default();
+    let mut obj = merge(&models, &materials)?;
+    obj.mtllibs = mtllibs;
+    Ok(obj)
 }
 
-/// Merges tobj's models (one per `o`/`g`/material group) into one mesh.
-fn merge(models: &[tobj::Model]) -> Result<Mesh, ObjError> {
+/// The text of a file whose lines must be UTF-8, except comments and the statements in
+/// `lossy` (whose bytes that are not UTF-8 become U+FFFD).
+pub(crate) fn utf8_lines<'b>(bytes: &'b [u8], lossy: &[&str]) -> Result<Cow<'b, str>, ObjError> {
+    if let Ok(text) = std::str::from_utf8(bytes) {
+        return Ok(Cow::Borrowed(text));
+    }
+    let mut text = String::with_capacity(bytes.len() + 16);
+    for (number, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if number > 0 {
+            text.push('\n');
+        }
+        match std::str::from_utf8(line) {
+            Ok(line) => text.push_str(line),
+            Err(_) => {
+                let keyword = line
+                    .split(u8::is_ascii_whitespace)
+                    .find(|w| !w.is_empty())
+                    .unwrap_or_default();
+                let comment = keyword.first() == Some(&b'#');
+                if !comment && !lossy.iter().any(|k| k.as_bytes() == keyword) {
+                    return Err(ObjError {
+                        line: Some(number + 1),
+                        message: format!(
+                            "not UTF-8 text (accepted only in comments{})",
+                            if lossy.is_empty() {
+                                String::new()
+                            } else {
+                                format!(" and `{}` statements", lossy.join("`, `"))
+                            }
+                        ),
+                        source: None,
+                    });
+                }
+                text.push_str(&String::from_utf8_lossy(line));
+            }
+        }
+    }
+    Ok(Cow::Owned(text))
+}
+
+/// Merges tobj's models (one per `o`/`g`/material group) into one mesh, remembering each
+/// triangle's `usemtl` group.
+fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh, ObjError> {
     let fail = |message: String| ObjError {
         line: None,
         message,
@@ -88,6 +203,8 @@ fn merge(models: &[tobj::Model]) -> Result<Mesh, ObjError> {
     let mut mesh = Mesh::default();
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
+    let mut groups: Vec<String> = Vec::new();
+    let mut triangle_groups = Vec::new();
     let (mut all_normals, mut all_uvs) = (true, true);
     for model in models {
         let m = &model.mesh;
@@ -96,6 +213,18 @@ fn merge(models: &[tobj::Model]) -> Result<Mesh, ObjError> {
         if base + count > u32::MAX as usize {
             return Err(fail("too many vertices".to_string()));
         }
+        let group = m
+            .material_id
+            .and_then(|id| materials.get(id))
+            .map(
+                |material| match groups.iter().position(|g| *g == material.name) {
+                    Some(i) => i as u32,
+                    None => {
+                        groups.push(material.name.clone());
+                        (groups.len() - 1) as u32
+                    }
+                },
+            );
         mesh.positions.extend(
             m.positions
                 .chunks_exact(3)
@@ -123,6 +252,7 @@ fn merge(models: &[tobj::Model]) -> Result<Mesh, ObjError> {
             }
             mesh.triangles
                 .push([t[0], t[1], t[2]].map(|i| i + base as u32));
+            triangle_groups.push(group);
         }
     }
     if mesh.triangles.is_empty() {
@@ -150,13 +280,23 @@ fn merge(models: &[tobj::Model]) -> Result<Mesh, ObjError> {
     let usable = all_normals
         && normals.len() == mesh.positions.len()
         && normals.iter().all(|n| n.is_finite() && n.length() > 1e-12);
-    mesh.normals = if usable {
-        normals.into_iter().map(Vec3::normalize).collect()
+    let mut warnings = Vec::new();
+    if usable {
+        mesh.normals = normals.into_iter().map(Vec3::normalize).collect();
+        warnings.extend(orient_outward(&mut mesh, true));
+        warnings.extend(normals_against_winding(&mesh));
     } else {
-        smooth_normals(&mesh.positions, &mesh.triangles)
-    };
+        warnings.extend(orient_outward(&mut mesh, false));
+        mesh.normals = smooth_normals(&mesh.positions, &mesh.triangles);
+    }
     validate_mesh(&mesh).map_err(fail)?;
-    Ok(mesh)
+    Ok(ObjMesh {
+        mesh,
+        groups,
+        triangle_groups,
+        mtllibs: Vec::new(),
+        warnings,
+    })
 }
 
 /// Checks face-index ranges the way `tobj` resolves them, reporting the first bad one with its
@@ -328,5 +468,64 @@ f 1 3 4
                 .flatten()
                 .all(|&i| (i as usize) < m.positions.len())
         );
+    }
+
+    #[test]
+    fn usemtl_groups_and_mtllibs_are_kept_per_triangle() {
+        let text = "mtllib a b.mtl\n  usemtl x\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+                    f 1 2 3\nusemtl y z\nf 1 2 4\nusemtl x\nf 1 3 4\nmtllib c.mtl\n";
+        let obj = load_obj(text.as_bytes()).expect("loads");
+        // tobj keeps names with spaces whole; an indented usemtl is found as well.
+        assert_eq!(obj.groups, vec!["x".to_string(), "y z".to_string()]);
+        assert_eq!(obj.triangle_groups, vec![Some(0), Some(1), Some(0)]);
+        assert_eq!(
+            obj.mtllibs,
+            vec![(1, "a b.mtl".to_string()), (12, "c.mtl".to_string())]
+        );
+        // Faces before any usemtl have no group.
+        let obj = load_obj(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert!(obj.groups.is_empty());
+        assert_eq!(obj.triangle_groups, vec![None]);
+    }
+
+    #[test]
+    fn bytes_that_are_not_utf8_are_accepted_only_where_unused() {
+        let ok = b"# caf\xe9\no t\xeate\ng \xff\ns \xff\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        assert_eq!(parse_obj(ok).expect("loads").triangles.len(), 1);
+        for (bytes, line) in [
+            (&b"v 0 0 0\nv 1 0 0\nv 0 1 \xb0\nf 1 2 3\n"[..], 3),
+            (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl \xe9\nf 1 2 3\n", 4),
+            (
+                b"mtllib caf\xe9.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                1,
+            ),
+        ] {
+            let e = parse_obj(bytes).expect_err("rejected");
+            assert_eq!(e.line, Some(line), "{e}");
+            assert!(e.message.contains("not UTF-8"), "{e}");
+        }
+    }
+
+    #[test]
+    fn coordinates_beyond_the_bound_are_rejected_quickly() {
+        let e = parse_obj(b"v -6e37 -6e37 0\nv 6e37 -6e37 0\nv 0 6e37 0\nf 1 2 3\n").unwrap_err();
+        assert!(e.message.contains("farther than 1e12"), "{e}");
+        // At the bound itself a mesh is fine.
+        let m = parse_obj(b"v -1e12 -1e12 0\nv 1e12 -1e12 0\nv 0 1e12 0\nf 1 2 3\n");
+        assert!(m.is_ok(), "{m:?}");
+    }
+
+    #[test]
+    fn file_normals_against_the_winding_give_a_warning() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 -1\nf 1//1 2//1 3//1\n";
+        let obj = load_obj(text.as_bytes()).unwrap();
+        assert_eq!(obj.warnings.len(), 1, "{:?}", obj.warnings);
+        assert!(
+            obj.warnings[0].contains("3 of 3 vertex normals"),
+            "{:?}",
+            obj.warnings
+        );
+        let agreeing = text.replace("vn 0 0 -1", "vn 0 0 1");
+        assert!(load_obj(agreeing.as_bytes()).unwrap().warnings.is_empty());
     }
 }

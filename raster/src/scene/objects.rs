@@ -1,7 +1,7 @@
 //! `[[object]]` tables → world-space [`Object`]s: an OBJ file or a built-in shape, placed by
-//! its transform, checked against the invariants of [`super::Mesh`].
+//! its transform, checked against the invariants of [`super::Mesh`]. An OBJ with several
+//! materials becomes several objects (`object_materials.rs`).
 
-use std::collections::HashMap;
 use std::path::Path;
 
 use toml::Spanned;
@@ -11,36 +11,32 @@ use super::error::SceneErrorKind;
 use super::format::RawObject;
 use super::mesh::{Transform, validate_mesh};
 use super::model::{Mesh, Object};
-use super::obj::parse_obj;
+use super::obj::{ObjMesh, load_obj};
+use super::object_materials::{MaterialTable, ObjGroups, split_by_material};
 use super::origin::SceneOrigin;
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
+use super::weld::{MAX_CREASE_DEGREES, weld_normals};
 
 /// Values accepted by `shape`.
 pub const SHAPES: [&str; 4] = ["plane", "sphere", "box", "disk"];
 
-/// What a material needs from the meshes that use it.
-pub(crate) struct MaterialRef<'n> {
-    /// Material index in the scene.
-    pub index: usize,
-    /// The key of a textured parameter, if the material has one (the mesh then needs UVs).
-    pub texture_key: Option<&'n str>,
-}
-
-/// Builds object `index`. `materials` maps names to indices and texture needs.
+/// Builds object `index` (several objects when an OBJ's groups map to several materials).
+/// `table` resolves material names, and collects new materials and warnings.
 pub(crate) fn build_object(
     c: &Check,
     index: usize,
     raw: &Spanned<RawObject>,
     origin: &SceneOrigin,
-    materials: &HashMap<&str, MaterialRef>,
-) -> Checked<Object> {
+    table: &mut MaterialTable,
+) -> Checked<Vec<Object>> {
     let o = raw.get_ref();
     let key = |k: &str| format!("object[{index}].{k}");
     // The material first: a typo there is the cheapest thing to report.
-    let material = materials
+    let material = *table
+        .by_name
         .get(o.material.get_ref().as_str())
         .ok_or_else(|| {
-            let mut names: Vec<_> = materials.keys().copied().collect();
+            let mut names: Vec<_> = table.by_name.keys().copied().collect();
             names.sort_unstable();
             c.at(
                 SceneErrorKind::UnknownName,
@@ -74,6 +70,7 @@ pub(crate) fn build_object(
             None => 1.0,
         },
     };
+    let mut groups: Option<ObjGroups> = None;
     let (mut mesh, default_name, source) = match (&o.obj, &o.shape) {
         (Some(_), Some(shape)) => {
             return Err(c.at(
@@ -99,7 +96,18 @@ pub(crate) fn build_object(
             c.forbid(&key("size"), &o.size, what)?;
             c.forbid(&key("radius"), &o.radius, what)?;
             c.forbid(&key("segments"), &o.segments, what)?;
-            let mesh = load_obj_file(c, &key("obj"), file, origin)?;
+            let obj = load_obj_file(c, &key("obj"), file, origin)?;
+            for warning in &obj.warnings {
+                let at = c.at(
+                    SceneErrorKind::Mesh,
+                    &key("obj"),
+                    file,
+                    format!("`{}`: {warning}", file.get_ref()),
+                );
+                table.warnings.push(at.to_string());
+            }
+            groups = Some(ObjGroups::from(&obj));
+            let mesh = obj.mesh;
             let stem = Path::new(file.get_ref())
                 .file_stem()
                 .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
@@ -110,22 +118,17 @@ pub(crate) fn build_object(
             )
         }
         (None, Some(shape)) => {
+            let what = "a built-in shape";
+            c.forbid(&key("materials"), &o.materials, what)?;
+            c.forbid(&key("weld"), &o.weld, what)?;
+            c.forbid(&key("crease_angle"), &o.crease_angle, what)?;
             let mesh = build_shape(c, index, raw)?;
             let name = shape.get_ref().clone();
             (mesh, name.clone(), (key("shape"), shape.span(), name))
         }
     };
-    if let (Some(texture_key), None) = (material.texture_key, &mesh.uvs) {
-        return Err(c.src.error(
-            SceneErrorKind::Mesh,
-            source.1,
-            source.0,
-            format!(
-                "`{}` has no texture coordinates, but material `{}` uses a texture for `{texture_key}`",
-                source.2,
-                o.material.get_ref()
-            ),
-        ));
+    if let Some(crease) = crease_angle(c, index, o)? {
+        weld_normals(&mut mesh, crease);
     }
     transform.apply(&mut mesh);
     validate_mesh(&mesh).map_err(|why| {
@@ -143,11 +146,43 @@ pub(crate) fn build_object(
         Some(n) => n.get_ref().clone(),
         None => default_name,
     };
-    Ok(Object {
+    split_by_material(
+        c,
+        index,
+        o,
         name,
         mesh,
-        material: material.index,
-    })
+        material,
+        groups.as_ref(),
+        table,
+        origin,
+        &source,
+    )
+}
+
+/// The crease angle to weld with, if `weld = true` or `crease_angle` ask for smooth normals
+/// (`weld = true` alone smooths across every edge: 180°).
+fn crease_angle(c: &Check, index: usize, o: &RawObject) -> Checked<Option<f32>> {
+    let key = |k: &str| format!("object[{index}].{k}");
+    let angle = match &o.crease_angle {
+        Some(v) => Some(c.num_where(
+            &key("crease_angle"),
+            v,
+            |x| (0.0..=MAX_CREASE_DEGREES).contains(&x),
+            &format!("must be between 0 and {MAX_CREASE_DEGREES} (degrees)"),
+        )?),
+        None => None,
+    };
+    match (&o.weld, angle) {
+        (Some(w), Some(_)) if !*w.get_ref() => Err(c.at(
+            SceneErrorKind::Conflict,
+            &key("crease_angle"),
+            o.crease_angle.as_ref().unwrap_or_else(|| unreachable!()),
+            "cannot be combined with `weld = false`: a crease angle welds the mesh",
+        )),
+        (Some(w), None) => Ok(w.get_ref().then_some(MAX_CREASE_DEGREES)),
+        (_, angle) => Ok(angle),
+    }
 }
 
 /// Reads and parses an OBJ file named by the scene.
@@ -156,7 +191,7 @@ fn load_obj_file(
     key: &str,
     file: &Spanned<String>,
     origin: &SceneOrigin,
-) -> Checked<Mesh> {
+) -> Checked<ObjMesh> {
     let path = origin.resolve(file.get_ref());
     let bytes = origin.read(file.get_ref()).map_err(|why| {
         c.at(
@@ -167,7 +202,7 @@ fn load_obj_file(
         )
         .with_source(why)
     })?;
-    parse_obj(&bytes).map_err(|e| {
+    load_obj(&bytes).map_err(|e| {
         c.at(
             SceneErrorKind::Mesh,
             key,

@@ -13,7 +13,9 @@ use lucent_core::QuerySettings;
 use lucent_core::glam::Vec3;
 use lucent_raster::raster::MAX_AA;
 use lucent_raster::scene::mesh::validate_mesh;
-use lucent_raster::scene::obj::parse_obj;
+use lucent_raster::scene::mtl::parse_mtl;
+use lucent_raster::scene::obj::load_obj;
+use lucent_raster::scene::weld::weld_normals;
 use lucent_raster::scene::{Light, Mesh, SceneOrigin, parse_scene};
 
 /// A small closed mesh (a tetrahedron with UVs and normals) served under the bunny's path, so
@@ -30,10 +32,30 @@ const RAMP_PNG: &[u8] = include_bytes!("../../../scenes/textures/mfp-ramp.png");
 /// The lat-long sky of `scenes/environment.toml`.
 const SKY_PNG: &[u8] = include_bytes!("../../../scenes/textures/sky-latlong.png");
 
+/// The two-material OBJ of `scenes/obj-materials.toml`, its `.mtl` and its `map_Kd`.
+const TWO_MATERIALS: [(&str, &[u8]); 3] = [
+    (
+        "meshes/two-materials.obj",
+        include_bytes!("../../../scenes/meshes/two-materials.obj"),
+    ),
+    (
+        "meshes/two-materials.mtl",
+        include_bytes!("../../../scenes/meshes/two-materials.mtl"),
+    ),
+    (
+        "meshes/two-materials-kd.png",
+        include_bytes!("../../../scenes/meshes/two-materials-kd.png"),
+    ),
+];
+
 /// Where fuzzed scenes come from: files served from memory under the names the repository's
-/// scenes use (`../assets/bunny.obj`, `textures/mfp-ramp.png`, `textures/sky-latlong.png`),
-/// plus `mesh.obj`.
+/// scenes use (`../assets/bunny.obj`, `textures/mfp-ramp.png`, `textures/sky-latlong.png`,
+/// `meshes/two-materials.*`), plus `mesh.obj`.
 pub fn fuzz_origin() -> SceneOrigin {
+    let mut files = TWO_MATERIALS
+        .iter()
+        .map(|&(name, bytes)| (name.to_string(), Cow::Borrowed(bytes)))
+        .collect::<Vec<_>>();
     SceneOrigin::Embedded {
         name: "<fuzz>/scene.toml".to_string(),
         files: vec![
@@ -50,7 +72,10 @@ pub fn fuzz_origin() -> SceneOrigin {
                 "textures/sky-latlong.png".to_string(),
                 Cow::Borrowed(SKY_PNG),
             ),
-        ],
+        ]
+        .into_iter()
+        .chain(files.drain(..))
+        .collect(),
     }
 }
 
@@ -140,10 +165,25 @@ pub fn scene_parse_never_panics(data: &[u8]) {
     }
 }
 
-/// The property of the fuzz target `obj_load_never_panics`: `parse_obj` returns a value or an
-/// error, and a value is a valid mesh. Panics when that fails.
+/// The property of the fuzz target `obj_load_never_panics`: `load_obj` returns a value or an
+/// error, and a value is a valid mesh whose every triangle has a group in range; welding it
+/// (at a 60° crease) keeps it valid with the same triangles. The same bytes read as a `.mtl`
+/// give materials or an error. Panics when that fails.
 pub fn obj_load_never_panics(data: &[u8]) {
-    if let Ok(mesh) = parse_obj(data) {
-        check_mesh("parse_obj", &mesh);
+    if let Ok(obj) = load_obj(data) {
+        check_mesh("load_obj", &obj.mesh);
+        assert_eq!(obj.triangle_groups.len(), obj.mesh.triangles.len());
+        assert!(
+            obj.triangle_groups
+                .iter()
+                .flatten()
+                .all(|&g| (g as usize) < obj.groups.len()),
+            "group out of range"
+        );
+        let mut welded = obj.mesh.clone();
+        weld_normals(&mut welded, 60.0);
+        check_mesh("weld_normals", &welded);
+        assert_eq!(welded.triangles.len(), obj.mesh.triangles.len());
     }
+    let _ = parse_mtl(data);
 }

@@ -1,7 +1,8 @@
 //! Deterministic golden-image tests.
 //!
-//! Six small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
-//! an opaque-only scene, the rect light and the environment map — are rendered and compared with files committed under
+//! Seven small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
+//! an opaque-only scene, the rect light, the environment map, and an OBJ with two materials
+//! (K_d from its `.mtl`) — are rendered and compared with files committed under
 //! `tests/golden/`:
 //!
 //! - `<name>.coverage.png`: the supersampled visibility buffer (triangle id + 1 as 24-bit RGB,
@@ -74,6 +75,10 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         (
             "environment",
             small(load("scenes/environment.toml"), 64, 3000),
+        ),
+        (
+            "obj-materials",
+            small(load("scenes/obj-materials.toml"), 64, 3000),
         ),
     ]
 }

@@ -6,6 +6,7 @@
 //! must point at by a piece of its text (`needle`).
 
 mod examples;
+mod obj_materials;
 mod ranges;
 mod references;
 mod robustness;

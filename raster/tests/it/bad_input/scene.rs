@@ -322,7 +322,7 @@ fn zero_and_huge_resolution_in_scene() {
 }
 
 /// A scene far too large for single precision (a translucent triangle 1e20 units across):
-/// a message saying so, not an internal error.
+/// rejected at load, at the key naming the mesh, not an internal error.
 #[test]
 fn scene_beyond_single_precision() {
     let sb = Sandbox::with_scene("scene-huge", &scene("obj = \"big.obj\"", CONSTANT));
@@ -330,7 +330,16 @@ fn scene_beyond_single_precision() {
         "big.obj",
         b"v -1e20 -1e20 0\nv 1e20 -1e20 0\nv 0 1e20 0\nf 1 2 3\n",
     );
-    let message = sb.fails(&render(&[]), 1, &["exceed single precision", "object 0"]);
+    let message = sb.fails(
+        &render(&[]),
+        1,
+        &[
+            "scene.toml:",
+            "object[0].obj",
+            "big.obj",
+            "farther than 1e12 units",
+        ],
+    );
     assert!(!message.contains("internal"), "{message}");
 }
 
