@@ -26,6 +26,7 @@ mod model;
 pub mod obj;
 mod objects;
 mod origin;
+pub mod ply;
 mod settings;
 pub mod shapes;
 

@@ -13,7 +13,7 @@ use std::io::BufReader;
 
 use glam::{Vec2, Vec3};
 
-use super::mesh::{drop_unused_vertices, smooth_normals, validate_mesh};
+use super::mesh::finish_loaded_mesh;
 use super::model::Mesh;
 
 /// Why an OBJ file could not be used.
@@ -130,33 +130,8 @@ fn merge(models: &[tobj::Model]) -> Result<Mesh, ObjError> {
             "the file defines no faces (a mesh needs at least one triangle)".to_string(),
         ));
     }
-    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(fail(format!(
-            "vertex {} is not finite: {:?}",
-            i + 1,
-            mesh.positions[i]
-        )));
-    }
-    if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
-        return Err(fail(format!(
-            "texture coordinate of vertex {} is not finite: {:?}",
-            i + 1,
-            uvs[i]
-        )));
-    }
     mesh.uvs = all_uvs.then_some(uvs);
-    drop_unused_vertices(&mut mesh);
-    // File normals are only trusted when every vertex has a usable one.
-    let usable = all_normals
-        && normals.len() == mesh.positions.len()
-        && normals.iter().all(|n| n.is_finite() && n.length() > 1e-12);
-    mesh.normals = if usable {
-        normals.into_iter().map(Vec3::normalize).collect()
-    } else {
-        smooth_normals(&mesh.positions, &mesh.triangles)
-    };
-    validate_mesh(&mesh).map_err(fail)?;
-    Ok(mesh)
+    finish_loaded_mesh(mesh, all_normals.then_some(normals)).map_err(fail)
 }
 
 /// Checks face-index ranges the way `tobj` resolves them, reporting the first bad one with its
