@@ -1,4 +1,4 @@
-//! `[[object]]` tables → world-space [`Object`]s: an OBJ file or a built-in shape, placed by
+//! `[[object]]` tables → world-space [`Object`]s: a mesh file (OBJ, PLY, glTF) or a built-in shape, placed by
 //! its transform, checked against the invariants of [`super::Mesh`].
 
 use std::collections::HashMap;
@@ -10,8 +10,8 @@ use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::RawObject;
 use super::mesh::{Transform, validate_mesh};
+use super::mesh_file::{MESH_EXTENSIONS, MeshFormat, parse_mesh_file};
 use super::model::{Mesh, Object};
-use super::obj::parse_obj;
 use super::origin::SceneOrigin;
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
 
@@ -74,40 +74,54 @@ pub(crate) fn build_object(
             None => 1.0,
         },
     };
-    let (mut mesh, default_name, source) = match (&o.obj, &o.shape) {
-        (Some(_), Some(shape)) => {
+    // `obj` is the older name of `mesh`.
+    let file = match (&o.mesh, &o.obj) {
+        (Some(_), Some(obj)) => {
+            return Err(c.at(
+                SceneErrorKind::Conflict,
+                &key("obj"),
+                obj,
+                "cannot be combined with `mesh` (`obj` is an older name for `mesh`)",
+            ));
+        }
+        (Some(file), None) => Some(("mesh", file)),
+        (None, Some(file)) => Some(("obj", file)),
+        (None, None) => None,
+    };
+    let (mut mesh, default_name, source) = match (file, &o.shape) {
+        (Some((name, _)), Some(shape)) => {
             return Err(c.at(
                 SceneErrorKind::Conflict,
                 &key("shape"),
                 shape,
-                "cannot be combined with `obj`: an object is an OBJ file or a built-in shape",
+                format!(
+                    "cannot be combined with `{name}`: an object is a mesh file or a built-in \
+                     shape"
+                ),
             ));
         }
         (None, None) => {
             return Err(c.at(
                 SceneErrorKind::MissingKey,
-                &key("obj"),
+                &key("mesh"),
                 raw,
                 format!(
-                    "an object needs `obj = \"file.obj\"` or `shape = ...` ({})",
+                    "an object needs `mesh = \"file.obj\"` (.obj, .ply, .gltf or .glb) or \
+                     `shape = ...` ({})",
                     SHAPES.join(", ")
                 ),
             ));
         }
-        (Some(file), None) => {
-            let what = "an OBJ mesh";
+        (Some((name, file)), None) => {
+            let what = "a mesh file";
             c.forbid(&key("size"), &o.size, what)?;
             c.forbid(&key("radius"), &o.radius, what)?;
             c.forbid(&key("segments"), &o.segments, what)?;
-            let mesh = load_obj_file(c, &key("obj"), file, origin)?;
+            let mesh = load_mesh(c, &key(name), file, origin)?;
             let stem = Path::new(file.get_ref())
                 .file_stem()
                 .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
-            (
-                mesh,
-                stem,
-                (key("obj"), file.span(), file.get_ref().clone()),
-            )
+            (mesh, stem, (key(name), file.span(), file.get_ref().clone()))
         }
         (None, Some(shape)) => {
             let mesh = build_shape(c, index, raw)?;
@@ -150,15 +164,22 @@ pub(crate) fn build_object(
     })
 }
 
-/// Reads and parses an OBJ file named by the scene.
-fn load_obj_file(
-    c: &Check,
-    key: &str,
-    file: &Spanned<String>,
-    origin: &SceneOrigin,
-) -> Checked<Mesh> {
-    let path = origin.resolve(file.get_ref());
-    let bytes = origin.read(file.get_ref()).map_err(|why| {
+/// Reads and parses a mesh file named by the scene, choosing the loader by its extension.
+fn load_mesh(c: &Check, key: &str, file: &Spanned<String>, origin: &SceneOrigin) -> Checked<Mesh> {
+    let name = file.get_ref();
+    let Some(format) = MeshFormat::from_path(name) else {
+        return Err(c.at(
+            SceneErrorKind::Mesh,
+            key,
+            file,
+            format!(
+                "`{name}` is not a known mesh format (the extension must be one of: .{})",
+                MESH_EXTENSIONS.join(", .")
+            ),
+        ));
+    };
+    let path = origin.resolve(name);
+    let bytes = origin.read(name).map_err(|why| {
         c.at(
             SceneErrorKind::Io,
             key,
@@ -167,7 +188,21 @@ fn load_obj_file(
         )
         .with_source(why)
     })?;
-    parse_obj(&bytes).map_err(|e| {
+    // Files a mesh refers to (glTF buffers) are relative to the mesh file.
+    let dir = Path::new(name).parent().unwrap_or(Path::new(""));
+    let mut read_file = |relative: &str| -> Result<Vec<u8>, String> {
+        let scene_relative = dir.join(relative).to_string_lossy().into_owned();
+        origin
+            .read(&scene_relative)
+            .map(|b| b.into_owned())
+            .map_err(|why| {
+                format!(
+                    "cannot read {}: {why}",
+                    origin.resolve(&scene_relative).display()
+                )
+            })
+    };
+    parse_mesh_file(format, &bytes, &mut read_file).map_err(|e| {
         c.at(
             SceneErrorKind::Mesh,
             key,
