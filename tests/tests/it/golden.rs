@@ -1,7 +1,7 @@
 //! Deterministic golden-image tests.
 //!
-//! Four small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
-//! and an opaque-only scene — are rendered and compared with files committed under
+//! Six small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
+//! an opaque-only scene, a binary-PLY bunny and a glTF egg under a node hierarchy — are rendered and compared with files committed under
 //! `tests/golden/`:
 //!
 //! - `<name>.coverage.png`: the supersampled visibility buffer (triangle id + 1 as 24-bit RGB,
@@ -67,6 +67,14 @@ fn scenes() -> Vec<(&'static str, Scene)> {
             small(load("scenes/textured-mfp.toml"), 64, 3000),
         ),
         ("opaque", small(load("tests/data/opaque.toml"), 64, 1000)),
+        (
+            "ply-bunny",
+            small(load("tests/data/ply-bunny.toml"), 64, 2000),
+        ),
+        (
+            "gltf-egg",
+            small(load("tests/data/gltf-egg.toml"), 64, 2000),
+        ),
     ]
 }
 
