@@ -2,7 +2,8 @@
 //! merged into one [`Mesh`] in the file's world space.
 //!
 //! The `gltf` crate parses and validates the document (every index reference resolved, required
-//! extensions refused) and splits GLB containers. Buffers and accessors are read here, every
+//! extensions refused) and splits GLB containers; one reference its validation trusts (a
+//! `POSITION` accessor) is checked here first. Buffers and accessors are read here, every
 //! offset, stride and count checked in overflow-free arithmetic against the bytes actually
 //! present, so a malformed file is an error and never a panic.
 //!
@@ -78,8 +79,11 @@ pub fn parse_gltf(
     bytes: &[u8],
     read_file: &mut dyn FnMut(&str) -> Result<Vec<u8>, String>,
 ) -> Result<GltfMesh, GltfError> {
+    let malformed = |e: gltf::Error| fail(format!("malformed glTF: {e}"));
     let gltf::Gltf { document, mut blob } =
-        gltf::Gltf::from_slice(bytes).map_err(|e| fail(format!("malformed glTF: {e}")))?;
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(malformed)?;
+    check_position_accessors(document.as_json())?;
+    let document = gltf::Document::from_json(document.into_json()).map_err(malformed)?;
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let what = format!("buffer {}", buffer.index());
@@ -138,6 +142,27 @@ pub fn parse_gltf(
     out.finish()
 }
 
+/// Checks that every `POSITION` attribute names an existing accessor. The `gltf` crate's
+/// validation (1.4) indexes the accessor list with it unchecked, which panics.
+fn check_position_accessors(root: &gltf::json::Root) -> Result<(), GltfError> {
+    let semantic = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive.attributes.get(&semantic)
+                && index.value() >= root.accessors.len()
+            {
+                return Err(fail(format!(
+                    "malformed glTF: mesh {m} primitive {p}: POSITION names accessor {}, but \
+                     there are {}",
+                    index.value(),
+                    root.accessors.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// `3` or `3 'name'`, for messages.
 fn name_of(index: usize, name: Option<&str>) -> String {
     match name {
@@ -168,7 +193,8 @@ fn local_matrix(node: &gltf::Node) -> DMat4 {
             let [x, y, z, w] = rotation.map(f64::from);
             DMat4::from_scale_rotation_translation(
                 DVec3::from(scale.map(f64::from)),
-                DQuat::from_xyzw(x, y, z, w),
+                // Unit in the file up to f32 rounding; renormalised in f64.
+                DQuat::from_xyzw(x, y, z, w).normalize(),
                 DVec3::from(translation.map(f64::from)),
             )
         }
