@@ -2,8 +2,8 @@
 //! merged into one [`Mesh`] in the file's world space.
 //!
 //! The `gltf` crate parses and validates the document (every index reference resolved, required
-//! extensions refused) and splits GLB containers; one reference its validation trusts (a
-//! `POSITION` accessor) is checked here first. Buffers and accessors are read here, every
+//! extensions refused) and splits GLB containers; what it trusts unchecked (a `POSITION`
+//! accessor index, a GLB's declared length) is checked here first. Buffers and accessors are read here, every
 //! offset, stride and count checked in overflow-free arithmetic against the bytes actually
 //! present, so a malformed file is an error and never a panic.
 //!
@@ -80,6 +80,17 @@ pub fn parse_gltf(
     read_file: &mut dyn FnMut(&str) -> Result<Vec<u8>, String>,
 ) -> Result<GltfMesh, GltfError> {
     let malformed = |e: gltf::Error| fail(format!("malformed glTF: {e}"));
+    // The `gltf` crate (1.4) subtracts the header size from a GLB's declared length unchecked.
+    if let Some(length) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+        && length < 12
+    {
+        return Err(fail(format!(
+            "malformed GLB: its declared length {length} is shorter than its 12-byte header"
+        )));
+    }
     let gltf::Gltf { document, mut blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(malformed)?;
     check_position_accessors(document.as_json())?;

@@ -233,7 +233,7 @@ fn glb_and_external_buffers_read_the_same_bytes() {
         r#"{"byteLength": 140}"#,
     )
     .into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let bin = quad_buffer();

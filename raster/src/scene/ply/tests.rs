@@ -184,7 +184,10 @@ fn cube(format: Format) -> Vec<u8> {
     )
 }
 
-fn bits(m: &Mesh) -> (Vec<u32>, Vec<u32>, Option<Vec<u32>>, Vec<[u32; 3]>) {
+/// A mesh's floats as bits: positions, normals, UVs, then its triangles.
+type MeshBits = (Vec<u32>, Vec<u32>, Option<Vec<u32>>, Vec<[u32; 3]>);
+
+fn bits(m: &Mesh) -> MeshBits {
     let v3 = |v: &[Vec3]| {
         v.iter()
             .flat_map(|p| p.to_array().map(f32::to_bits))
