@@ -2,7 +2,7 @@
 //! models, Meshlab, Blender): ASCII, binary little-endian and binary big-endian bodies.
 //!
 //! The header goes through the same parser as lucent's sample sets
-//! ([`crate::output::ply::header`]). From it this reader uses:
+//! (`crate::output::ply::header`). From it this reader uses:
 //!
 //! - `element vertex`: `x`, `y`, `z` (any scalar type), the normal `nx`, `ny`, `nz` when all
 //!   three are present, texture coordinates from the first pair present among `u`/`v`,
