@@ -5,6 +5,8 @@ Run from anywhere: `python3 fuzz/make_seeds.py`. Seeds are named by what they ex
 byte layouts are documented in tests/src/fuzz_props/*.rs. Minimised inputs that found bugs
 (crash-*) or limitations (regress-*) are left alone.
 """
+import base64
+import json
 import math
 import os
 import struct
@@ -293,6 +295,93 @@ def obj_seeds():
     write(t, "mtl-options.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd -s 1 1 1 a.png\nnewmtl b\nmap_Kd b c.png\n")
 
 
+# --------------------------------------------------------------------------- ply_load_never_panics
+def ply_body(fmt, verts, faces, vprops="property float x\nproperty float y\nproperty float z\n",
+             count="uchar", index="int", extra=""):
+    head = (f"ply\nformat {fmt} 1.0\ncomment fuzz seed\nelement vertex {len(verts)}\n{vprops}"
+            f"element face {len(faces)}\nproperty list {count} {index} vertex_indices\n{extra}end_header\n")
+    if fmt == "ascii":
+        body = "".join(" ".join(repr(float(x)) for x in v) + "\n" for v in verts)
+        body += "".join(f"{len(f)} " + " ".join(str(i) for i in f) + "\n" for f in faces)
+        return (head + body).encode()
+    e = "<" if fmt == "binary_little_endian" else ">"
+    codes = {"uchar": "B", "ushort": "H", "int": "i", "uint": "I", "short": "h", "char": "b"}
+    body = b"".join(struct.pack(e + "f" * len(v), *v) for v in verts)
+    for f in faces:
+        body += struct.pack(e + codes[count], len(f)) + struct.pack(e + codes[index] * len(f), *f)
+    return head.encode() + body
+
+
+def ply_seeds():
+    t = "ply_load_never_panics"
+    cube = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+    quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]
+    write(t, "cube-ascii.ply", ply_body("ascii", cube, quads))
+    write(t, "cube-le.ply", ply_body("binary_little_endian", cube, quads))
+    write(t, "cube-be-ushort-uint.ply", ply_body("binary_big_endian", cube, quads, count="ushort", index="uint"))
+    tri = [(0, 0, 0, 0, 0, 1, 0, 0), (1, 0, 0, 0, 0, 1, 1, 0), (0, 1, 0, 0, 0, 1, 0, 1)]
+    props = "".join(f"property float {n}\n" for n in ["x", "y", "z", "nx", "ny", "nz", "s", "t"])
+    write(t, "triangle-normals-uv-le.ply", ply_body("binary_little_endian", tri, [[0, 1, 2]], vprops=props))
+    write(t, "triangle-normals-uv-ascii.ply", ply_body("ascii", tri, [[0, 1, 2]], vprops=props))
+    # Skipped elements and list properties around the faces.
+    skip = ("ply\nformat ascii 1.0\nelement material 1\nproperty list uchar float rgb\n"
+            "element vertex 3\nproperty float x\nproperty float y\nproperty uchar red\nproperty float z\n"
+            "element face 1\nproperty list uchar float texcoord\nproperty list uchar int vertex_index\n"
+            "element edge 1\nproperty int a\nproperty int b\nend_header\n"
+            "3 0.1 0.2 0.3\n0 0 7 0\n1 0 7 0\n0 1 7 0\n2 0.5 0.5 3 0 1 2\n0 1\n")
+    write(t, "skipped-elements-ascii.ply", skip.encode())
+    with open(os.path.join(ROOT, "tests", "data", "meshes", "bunny.ply"), "rb") as f:
+        bunny = f.read()
+    write(t, "bunny-head-cut.ply", bunny[:2000])
+    write(t, "huge-count.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
+          b"property float x\nproperty float y\nproperty float z\nelement face 1\n"
+          b"property list uint int vertex_indices\nend_header\n" + b"\0" * 40)
+
+
+# -------------------------------------------------------------------------- gltf_load_never_panics
+def gltf_doc(buffer_json, mode=4, extra_nodes=""):
+    return json.dumps({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"translation": [1, 2, 3], "rotation": [0, 0, 0.6, 0.8], "scale": [1, 2, 3], "children": [1]},
+                  {"matrix": [0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1], "mesh": 0}],
+        "meshes": [{"name": "quad", "primitives": [
+            {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "mode": mode, "material": 0}]}],
+        "materials": [{"name": "wax"}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 0, "byteOffset": 48, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 0, "byteOffset": 96, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+        "bufferViews": [{"buffer": 0, "byteLength": 128}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}],
+        "buffers": [buffer_json],
+    }).encode()
+
+
+def quad_buffer():
+    corners = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    b = b"".join(struct.pack("<3f", x, y, 0) for x, y in corners)
+    b += b"".join(struct.pack("<3f", 0, 0, 1) for _ in corners)
+    b += b"".join(struct.pack("<2f", x, y) for x, y in corners)
+    return b + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+
+
+def gltf_seeds():
+    t = "gltf_load_never_panics"
+    data = "data:application/octet-stream;base64," + base64.b64encode(quad_buffer()).decode()
+    write(t, "quad-embedded.gltf", gltf_doc({"byteLength": 140, "uri": data}))
+    write(t, "quad-external.gltf", gltf_doc({"byteLength": 140, "uri": "buffer.bin"}))
+    write(t, "quad-strip.gltf", gltf_doc({"byteLength": 140, "uri": data}, mode=5))
+    js = gltf_doc({"byteLength": 140})
+    js += b" " * (-len(js) % 4)
+    bin_ = quad_buffer()
+    chunks = struct.pack("<I", len(js)) + b"JSON" + js + struct.pack("<I", len(bin_)) + b"BIN\0" + bin_
+    write(t, "quad.glb", b"glTF" + struct.pack("<II", 2, 12 + len(chunks)) + chunks)
+    with open(os.path.join(ROOT, "tests", "data", "meshes", "egg.glb"), "rb") as f:
+        write(t, "egg.glb", f.read())
+
+
 # ----------------------------------------------------------------------- raster_triangle_in_bounds
 def raster_seeds():
     t = "raster_triangle_in_bounds"
@@ -445,6 +534,8 @@ if __name__ == "__main__":
     table_seeds()
     scene_seeds()
     obj_seeds()
+    ply_seeds()
+    gltf_seeds()
     raster_seeds()
     shadow_seeds()
     convexity_seeds()

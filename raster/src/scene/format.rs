@@ -56,6 +56,7 @@ pub(crate) struct RawCamera {
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawObject {
     pub name: Option<Str>,
+    pub mesh: Option<Str>,
     pub obj: Option<Str>,
     pub shape: Option<Str>,
     pub size: Option<Spanned<Components>>,

@@ -149,6 +149,50 @@ fn keep<T: Copy>(v: &[T], used: &[bool]) -> Vec<T> {
 /// of millions), and no sensible unit needs it: 10¹² m is seven times the Earth–Sun distance.
 pub const MAX_COORDINATE: f32 = 1e12;
 
+/// The common end of every mesh-file loader (OBJ, PLY, glTF): rejects non-finite positions and
+/// UVs, drops unused vertices, keeps the file's `normals` (one per vertex, in `positions`
+/// order) only when every used vertex has a usable one and otherwise computes
+/// [`smooth_normals`], then checks [`validate_mesh`]. Vertex numbers in messages are 1-based.
+pub fn finish_loaded_mesh(mut mesh: Mesh, normals: Option<Vec<Vec3>>) -> Result<Mesh, String> {
+    reject_non_finite(&mesh)?;
+    mesh.normals = normals.unwrap_or_default();
+    drop_unused_vertices(&mut mesh);
+    // File normals are only trusted when every vertex has a usable one.
+    let usable = mesh.normals.len() == mesh.positions.len()
+        && mesh
+            .normals
+            .iter()
+            .all(|n| n.is_finite() && n.length() > 1e-12);
+    mesh.normals = if usable {
+        mesh.normals.iter().map(|n| n.normalize()).collect()
+    } else {
+        smooth_normals(&mesh.positions, &mesh.triangles)
+    };
+    validate_mesh(&mesh)?;
+    Ok(mesh)
+}
+
+/// A loaded mesh's positions and UVs must be finite (vertex numbers 1-based, as in files).
+pub fn reject_non_finite(mesh: &Mesh) -> Result<(), String> {
+    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(format!(
+            "vertex {} is not finite: {:?}",
+            i + 1,
+            mesh.positions[i]
+        ));
+    }
+    if let Some(uvs) = &mesh.uvs
+        && let Some(i) = uvs.iter().position(|t| !t.is_finite())
+    {
+        return Err(format!(
+            "texture coordinate of vertex {} is not finite: {:?}",
+            i + 1,
+            uvs[i]
+        ));
+    }
+    Ok(())
+}
+
 /// Checks every invariant documented on [`Mesh`]; the error says which one failed.
 pub fn validate_mesh(mesh: &Mesh) -> Result<(), String> {
     let n = mesh.positions.len();

@@ -1,4 +1,4 @@
-//! Scenes: the TOML format, OBJ meshes and built-in shapes, and the default scene.
+//! Scenes: the TOML format, OBJ, PLY and glTF meshes and built-in shapes, and the default scene.
 //!
 //! The format is documented in `docs/scene-format.md`. Loading goes text → serde structures
 //! mirroring the tables (`format.rs`; unknown keys and wrong types rejected) → value checks,
@@ -18,16 +18,19 @@ mod check;
 mod default;
 mod error;
 mod format;
+pub mod gltf;
 mod lights;
 mod load;
 mod materials;
 pub mod mesh;
+pub mod mesh_file;
 mod model;
 pub mod mtl;
 pub mod obj;
 mod object_materials;
 mod objects;
 mod origin;
+pub mod ply;
 pub mod sanity;
 mod settings;
 pub mod shapes;

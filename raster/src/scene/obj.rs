@@ -17,7 +17,7 @@ use std::io::BufReader;
 
 use glam::{Vec2, Vec3};
 
-use super::mesh::{drop_unused_vertices, smooth_normals, validate_mesh};
+use super::mesh::{drop_unused_vertices, reject_non_finite, smooth_normals, validate_mesh};
 use super::model::Mesh;
 use super::sanity::{normals_against_winding, orient_outward};
 
@@ -260,21 +260,8 @@ fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh
             "the file defines no faces (a mesh needs at least one triangle)".to_string(),
         ));
     }
-    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(fail(format!(
-            "vertex {} is not finite: {:?}",
-            i + 1,
-            mesh.positions[i]
-        )));
-    }
-    if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
-        return Err(fail(format!(
-            "texture coordinate of vertex {} is not finite: {:?}",
-            i + 1,
-            uvs[i]
-        )));
-    }
     mesh.uvs = all_uvs.then_some(uvs);
+    reject_non_finite(&mesh).map_err(fail)?;
     drop_unused_vertices(&mut mesh);
     // File normals are only trusted when every vertex has a usable one.
     let usable = all_normals

@@ -1,6 +1,6 @@
-//! `[[object]]` tables → world-space [`Object`]s: an OBJ file or a built-in shape, placed by
-//! its transform, checked against the invariants of [`super::Mesh`]. An OBJ with several
-//! materials becomes several objects (`object_materials.rs`).
+//! `[[object]]` tables → world-space [`Object`]s: a mesh file (OBJ, PLY, glTF) or a built-in
+//! shape, placed by its transform, checked against the invariants of [`super::Mesh`]. An OBJ
+//! with several materials becomes several objects (`object_materials.rs`).
 
 use std::path::Path;
 
@@ -10,6 +10,7 @@ use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::RawObject;
 use super::mesh::{Transform, validate_mesh};
+use super::mesh_file::{MESH_EXTENSIONS, MeshFileError, MeshFormat, parse_mesh_file};
 use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialTable, ObjGroups, split_by_material};
@@ -71,51 +72,73 @@ pub(crate) fn build_object(
         },
     };
     let mut groups: Option<ObjGroups> = None;
-    let (mut mesh, default_name, source) = match (&o.obj, &o.shape) {
-        (Some(_), Some(shape)) => {
+    // `obj` is the older name of `mesh`.
+    let file = match (&o.mesh, &o.obj) {
+        (Some(_), Some(obj)) => {
+            return Err(c.at(
+                SceneErrorKind::Conflict,
+                &key("obj"),
+                obj,
+                "cannot be combined with `mesh` (`obj` is an older name for `mesh`)",
+            ));
+        }
+        (Some(file), None) => Some(("mesh", file)),
+        (None, Some(file)) => Some(("obj", file)),
+        (None, None) => None,
+    };
+    let (mut mesh, default_name, source) = match (file, &o.shape) {
+        (Some((name, _)), Some(shape)) => {
             return Err(c.at(
                 SceneErrorKind::Conflict,
                 &key("shape"),
                 shape,
-                "cannot be combined with `obj`: an object is an OBJ file or a built-in shape",
+                format!(
+                    "cannot be combined with `{name}`: an object is a mesh file or a built-in \
+                     shape"
+                ),
             ));
         }
         (None, None) => {
             return Err(c.at(
                 SceneErrorKind::MissingKey,
-                &key("obj"),
+                &key("mesh"),
                 raw,
                 format!(
-                    "an object needs `obj = \"file.obj\"` or `shape = ...` ({})",
+                    "an object needs `mesh = \"file.obj\"` (.obj, .ply, .gltf or .glb) or \
+                     `shape = ...` ({})",
                     SHAPES.join(", ")
                 ),
             ));
         }
-        (Some(file), None) => {
-            let what = "an OBJ mesh";
+        (Some((name, file)), None) => {
+            let what = "a mesh file";
             c.forbid(&key("size"), &o.size, what)?;
             c.forbid(&key("radius"), &o.radius, what)?;
             c.forbid(&key("segments"), &o.segments, what)?;
-            let obj = load_obj_file(c, &key("obj"), file, origin)?;
-            for warning in &obj.warnings {
-                let at = c.at(
-                    SceneErrorKind::Mesh,
-                    &key("obj"),
-                    file,
-                    format!("`{}`: {warning}", file.get_ref()),
-                );
-                table.warnings.push(at.to_string());
-            }
-            groups = Some(ObjGroups::from(&obj));
-            let mesh = obj.mesh;
+            let loaded = load_mesh(c, &key(name), file, origin)?;
+            let mesh = match loaded {
+                Loaded::Obj(obj) => {
+                    for warning in &obj.warnings {
+                        let at = c.at(
+                            SceneErrorKind::Mesh,
+                            &key(name),
+                            file,
+                            format!("`{}`: {warning}", file.get_ref()),
+                        );
+                        table.warnings.push(at.to_string());
+                    }
+                    groups = Some(ObjGroups::from(&obj));
+                    obj.mesh
+                }
+                Loaded::Other(mesh) => {
+                    c.forbid(&key("materials"), &o.materials, "a PLY or glTF mesh")?;
+                    mesh
+                }
+            };
             let stem = Path::new(file.get_ref())
                 .file_stem()
                 .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
-            (
-                mesh,
-                stem,
-                (key("obj"), file.span(), file.get_ref().clone()),
-            )
+            (mesh, stem, (key(name), file.span(), file.get_ref().clone()))
         }
         (None, Some(shape)) => {
             let what = "a built-in shape";
@@ -185,15 +208,33 @@ fn crease_angle(c: &Check, index: usize, o: &RawObject) -> Checked<Option<f32>> 
     }
 }
 
-/// Reads and parses an OBJ file named by the scene.
-fn load_obj_file(
+/// A mesh file as read: an OBJ keeps its `usemtl` groups and repair warnings.
+enum Loaded {
+    Obj(ObjMesh),
+    Other(Mesh),
+}
+
+/// Reads and parses a mesh file named by the scene, choosing the loader by its extension.
+fn load_mesh(
     c: &Check,
     key: &str,
     file: &Spanned<String>,
     origin: &SceneOrigin,
-) -> Checked<ObjMesh> {
-    let path = origin.resolve(file.get_ref());
-    let bytes = origin.read(file.get_ref()).map_err(|why| {
+) -> Checked<Loaded> {
+    let name = file.get_ref();
+    let Some(format) = MeshFormat::from_path(name) else {
+        return Err(c.at(
+            SceneErrorKind::Mesh,
+            key,
+            file,
+            format!(
+                "`{name}` is not a known mesh format (the extension must be one of: .{})",
+                MESH_EXTENSIONS.join(", .")
+            ),
+        ));
+    };
+    let path = origin.resolve(name);
+    let bytes = origin.read(name).map_err(|why| {
         c.at(
             SceneErrorKind::Io,
             key,
@@ -202,7 +243,7 @@ fn load_obj_file(
         )
         .with_source(why)
     })?;
-    load_obj(&bytes).map_err(|e| {
+    let located = |e: MeshFileError| {
         c.at(
             SceneErrorKind::Mesh,
             key,
@@ -210,7 +251,29 @@ fn load_obj_file(
             format!("in {}: {e}", path.display()),
         )
         .with_source(e)
-    })
+    };
+    if format == MeshFormat::Obj {
+        return load_obj(&bytes)
+            .map(Loaded::Obj)
+            .map_err(|e| located(MeshFileError::Obj(e)));
+    }
+    // Files a mesh refers to (glTF buffers) are relative to the mesh file.
+    let dir = Path::new(name).parent().unwrap_or(Path::new(""));
+    let mut read_file = |relative: &str| -> Result<Vec<u8>, String> {
+        let scene_relative = dir.join(relative).to_string_lossy().into_owned();
+        origin
+            .read(&scene_relative)
+            .map(|b| b.into_owned())
+            .map_err(|why| {
+                format!(
+                    "cannot read {}: {why}",
+                    origin.resolve(&scene_relative).display()
+                )
+            })
+    };
+    parse_mesh_file(format, &bytes, &mut read_file)
+        .map(Loaded::Other)
+        .map_err(located)
 }
 
 /// Builds a built-in shape from its keys.

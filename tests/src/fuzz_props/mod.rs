@@ -11,6 +11,8 @@
 //! | [`table_lookup_finite`] | local-integral lookups finite, bounded by Rd_total, monotone in ℓ |
 //! | [`scene_parse_never_panics`] | arbitrary bytes → a scene or an error, a scene sound |
 //! | [`obj_load_never_panics`] | arbitrary bytes → a mesh or an error, a mesh valid |
+//! | [`ply_load_never_panics`] | arbitrary bytes → a PLY mesh or an error, a mesh valid |
+//! | [`gltf_load_never_panics`] | arbitrary bytes → a glTF mesh or an error, a mesh valid, its material groups tiling it |
 //! | [`raster_triangle_in_bounds`] | arbitrary clip-space triangles → coverage and depth as an oracle says |
 //! | [`shadow_rays_match_brute_force`] | BVH any-hit (plain, hinted) and closest hit against a brute-force loop |
 //! | [`convexity_is_sound`] | a mesh `cannot_shadow_itself` accepts is flat or convex by an exhaustive check |
@@ -18,6 +20,7 @@
 mod cache;
 mod convexity;
 pub mod input;
+mod meshes;
 mod parse;
 mod raster;
 mod shadow;
@@ -25,6 +28,7 @@ mod table;
 
 pub use cache::{MAX_FUZZ_SAMPLES, cache_query_matches_exhaustive};
 pub use convexity::convexity_is_sound;
+pub use meshes::{gltf_load_never_panics, ply_load_never_panics};
 pub use parse::{SMALL_MESH_OBJ, fuzz_origin, obj_load_never_panics, scene_parse_never_panics};
 pub use raster::raster_triangle_in_bounds;
 pub use shadow::shadow_rays_match_brute_force;
@@ -34,7 +38,7 @@ pub use table::table_lookup_finite;
 pub type Property = fn(&[u8]);
 
 /// Every target by name, with its property: what the replay test and tools iterate over.
-pub const TARGETS: [(&str, Property); 7] = [
+pub const TARGETS: [(&str, Property); 9] = [
     (
         "cache_query_matches_exhaustive",
         cache_query_matches_exhaustive,
@@ -42,6 +46,8 @@ pub const TARGETS: [(&str, Property); 7] = [
     ("table_lookup_finite", table_lookup_finite),
     ("scene_parse_never_panics", scene_parse_never_panics),
     ("obj_load_never_panics", obj_load_never_panics),
+    ("ply_load_never_panics", ply_load_never_panics),
+    ("gltf_load_never_panics", gltf_load_never_panics),
     ("raster_triangle_in_bounds", raster_triangle_in_bounds),
     (
         "shadow_rays_match_brute_force",

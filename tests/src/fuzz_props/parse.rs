@@ -79,7 +79,8 @@ pub fn fuzz_origin() -> SceneOrigin {
     }
 }
 
-fn check_mesh(what: &str, mesh: &Mesh) {
+/// Panics unless `mesh` passes `validate_mesh`, with indices in range and finite positions.
+pub(super) fn check_mesh(what: &str, mesh: &Mesh) {
     if let Err(e) = validate_mesh(mesh) {
         panic!("{what}: the loader returned an invalid mesh: {e}");
     }

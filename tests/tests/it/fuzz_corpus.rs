@@ -67,6 +67,16 @@ fn obj_load_never_panics() {
 }
 
 #[test]
+fn ply_load_never_panics() {
+    replay("ply_load_never_panics");
+}
+
+#[test]
+fn gltf_load_never_panics() {
+    replay("gltf_load_never_panics");
+}
+
+#[test]
 fn raster_triangle_in_bounds() {
     replay("raster_triangle_in_bounds");
 }

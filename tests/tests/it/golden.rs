@@ -1,8 +1,9 @@
 //! Deterministic golden-image tests.
 //!
-//! Seven small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
-//! an opaque-only scene, the rect light, the environment map, and an OBJ with two materials
-//! (K_d from its `.mtl`) — are rendered and compared with files committed under
+//! Nine small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
+//! an opaque-only scene, the rect light, the environment map, an OBJ with two materials (K_d
+//! from its `.mtl`), a binary-PLY bunny and a glTF egg under a node hierarchy — are rendered
+//! and compared with files committed under
 //! `tests/golden/`:
 //!
 //! - `<name>.coverage.png`: the supersampled visibility buffer (triangle id + 1 as 24-bit RGB,
@@ -79,6 +80,14 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         (
             "obj-materials",
             small(load("scenes/obj-materials.toml"), 64, 3000),
+        ),
+        (
+            "ply-bunny",
+            small(load("tests/data/ply-bunny.toml"), 64, 2000),
+        ),
+        (
+            "gltf-egg",
+            small(load("tests/data/gltf-egg.toml"), 64, 2000),
         ),
     ]
 }

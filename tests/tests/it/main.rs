@@ -8,5 +8,6 @@
 mod edge_reference;
 mod fuzz_corpus;
 mod golden;
+mod meshes;
 mod render_physics;
 mod shading_aa;

@@ -58,9 +58,11 @@ use glam::Vec3;
 
 use super::OutputError;
 use super::atomic::write_atomically;
-use header::{header_err, parse_header};
+use header::Header;
+use layout::{header_err, sample_header, sample_layout};
 
-mod header;
+pub(crate) mod header;
+mod layout;
 
 /// The comment that marks (and versions) a lucent sample set.
 pub const FORMAT_COMMENT: &str = "lucent sample-set v1";
@@ -68,9 +70,6 @@ pub const FORMAT_COMMENT: &str = "lucent sample-set v1";
 /// The most samples the reader accepts (2²⁸ ≈ 268 million, 10.7 GB of samples): larger
 /// counts are taken to be corruption.
 pub const MAX_SAMPLES: u64 = 1 << 28;
-
-/// Longest header the reader accepts.
-const MAX_HEADER_BYTES: u64 = 64 * 1024;
 
 /// How far a normal's length may be from 1.
 const NORMAL_TOLERANCE: f32 = 1e-3;
@@ -189,17 +188,7 @@ pub fn write_ply(path: &Path, samples: &SampleSet, comments: &[&str]) -> Result<
         }
     }
 
-    let mut header = String::new();
-    header.push_str("ply\nformat binary_little_endian 1.0\n");
-    header.push_str(&format!("comment {FORMAT_COMMENT}\n"));
-    for c in comments {
-        header.push_str(&format!("comment {c}\n"));
-    }
-    header.push_str(&format!("element vertex {}\n", samples.len()));
-    for p in PROPERTIES {
-        header.push_str(&format!("property float {p}\n"));
-    }
-    header.push_str("end_header\n");
+    let header = sample_header(samples.len(), comments).to_text();
 
     let io_err = |e| OutputError::io(path, "writing the PLY failed", e);
     write_atomically(path, |w| {
@@ -245,12 +234,14 @@ pub fn read_ply_with_comments(path: &Path) -> Result<(SampleSet, Vec<String>), O
         .map_err(|e| OutputError::io(path, "reading the PLY's size failed", e))?
         .len();
     let mut reader = BufReader::new(file);
-    let header = parse_header(path, &mut reader)?;
+    let header = Header::parse(&mut reader).map_err(|e| OutputError::from((path, e)))?;
+    let length = header.length;
+    let header = sample_layout(path, header)?;
 
     let expected = header
         .vertex_count
         .checked_mul(header.stride)
-        .and_then(|body| body.checked_add(header.length))
+        .and_then(|body| body.checked_add(length))
         .ok_or_else(|| header_err(path, 0, "vertex count times vertex size overflows"))?;
     if expected != file_len {
         return Err(OutputError::PlySize {

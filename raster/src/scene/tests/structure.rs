@@ -64,7 +64,7 @@ fn missing_keys() {
         edit("material = \"m\"\n", "") => "[[object]]", "object[0].material", "missing required key";
         edit("type = \"translucent\"\n", "") => "[material.m]", "material.m.type", "missing required key";
         edit("type = \"point\"\n", "") => "[[light]]", "light[0].type", "missing required key";
-        edit("shape = \"sphere\"\nradius = 1\n", "") => "[[object]]", "object[0].obj", "shape";
+        edit("shape = \"sphere\"\nradius = 1\n", "") => "[[object]]", "object[0].mesh", "shape";
         edit("radius = 1\n", "") => "[[object]]", "object[0].radius", "shape `sphere`";
         edit("mm_per_unit = 10\n", "") => "[material.m]", "material.m.mm_per_unit", "preset";
         edit(PRESET, "") => "[material.m]", "material.m", "exactly one of";
