@@ -15,6 +15,7 @@ use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialTable, ObjGroups, split_by_material};
 use super::origin::SceneOrigin;
+use super::sanity::{normals_against_winding, orient_outward};
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
 use super::weld::{MAX_CREASE_DEGREES, weld_normals};
 
@@ -116,25 +117,30 @@ pub(crate) fn build_object(
             c.forbid(&key("radius"), &o.radius, what)?;
             c.forbid(&key("segments"), &o.segments, what)?;
             let loaded = load_mesh(c, &key(name), file, origin)?;
-            let mesh = match loaded {
+            let (mesh, warnings) = match loaded {
                 Loaded::Obj(obj) => {
-                    for warning in &obj.warnings {
-                        let at = c.at(
-                            SceneErrorKind::Mesh,
-                            &key(name),
-                            file,
-                            format!("`{}`: {warning}", file.get_ref()),
-                        );
-                        table.warnings.push(at.to_string());
-                    }
                     groups = Some(ObjGroups::from(&obj));
-                    obj.mesh
+                    (obj.mesh, obj.warnings)
                 }
-                Loaded::Other(mesh) => {
+                Loaded::Other(mut mesh) => {
                     c.forbid(&key("materials"), &o.materials, "a PLY or glTF mesh")?;
-                    mesh
+                    // The same repairs as for OBJ files. The normals are the file's or were
+                    // computed from the winding: either way they follow the flip when they
+                    // agreed with the inverted winding.
+                    let flipped = orient_outward(&mut mesh, true);
+                    let against = normals_against_winding(&mesh);
+                    (mesh, flipped.into_iter().chain(against).collect())
                 }
             };
+            for warning in &warnings {
+                let at = c.at(
+                    SceneErrorKind::Mesh,
+                    &key(name),
+                    file,
+                    format!("`{}`: {warning}", file.get_ref()),
+                );
+                table.warnings.push(at.to_string());
+            }
             let stem = Path::new(file.get_ref())
                 .file_stem()
                 .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());

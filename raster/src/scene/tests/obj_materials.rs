@@ -64,6 +64,13 @@ fn origin() -> SceneOrigin {
         ),
         ("m/inside-out.obj", INSIDE_OUT.into()),
         (
+            "m/inside-out.ply",
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+             property float z\nelement face 4\nproperty list uchar int vertex_indices\n\
+             end_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n"
+                .into(),
+        ),
+        (
             "m/latin1.obj",
             b"# caf\xe9\no t\xe9te\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
         ),
@@ -279,6 +286,16 @@ fn inside_out_meshes_are_flipped_with_a_warning() {
     assert!(w.starts_with(&format!("t.toml:{line}:")), "{w}");
     assert!(w.contains("inside out"), "{w}");
     assert!(crate::scene::sanity::signed_volume(&s.objects[0].mesh) > 0.0);
+    // PLY (and glTF) meshes get the same repair; their computed normals follow the flip.
+    let s = scene("mesh = \"m/inside-out.ply\"\nmaterial = \"plain\"\n").unwrap();
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("inside out"), "{}", s.warnings[0]);
+    let mesh = &s.objects[0].mesh;
+    assert!(crate::scene::sanity::signed_volume(mesh) > 0.0);
+    let centre = mesh.positions.iter().copied().sum::<glam::Vec3>() / 4.0;
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        assert!(n.dot(*p - centre) > 0.0, "normal {n} at {p} points in");
+    }
 }
 
 #[test]
