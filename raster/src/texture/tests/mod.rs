@@ -1,5 +1,8 @@
 use super::*;
 
+mod encode;
+mod formats;
+
 /// Encodes a PNG in memory for the tests.
 pub(crate) fn encode_png(
     width: u32,
