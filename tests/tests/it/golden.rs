@@ -1,8 +1,8 @@
 //! Deterministic golden-image tests.
 //!
-//! Four small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
-//! and an opaque-only scene — are rendered and compared with files committed under
-//! `tests/golden/`:
+//! Six small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
+//! an opaque-only scene, a JPEG K_d texture and an OpenEXR ℓ_u texture — are rendered and
+//! compared with files committed under `tests/golden/`:
 //!
 //! - `<name>.coverage.png`: the supersampled visibility buffer (triangle id + 1 as 24-bit RGB,
 //!   black = empty), compared **exactly**;
@@ -67,6 +67,14 @@ fn scenes() -> Vec<(&'static str, Scene)> {
             small(load("scenes/textured-mfp.toml"), 64, 3000),
         ),
         ("opaque", small(load("tests/data/opaque.toml"), 64, 1000)),
+        (
+            "textured-kd-jpeg",
+            small(load("scenes/textured-kd-jpeg.toml"), 64, 3000),
+        ),
+        (
+            "textured-mfp-exr",
+            small(load("scenes/textured-mfp-exr.toml"), 64, 3000),
+        ),
     ]
 }
 

@@ -2,6 +2,7 @@ use super::*;
 
 mod encode;
 mod formats;
+mod scene_textures;
 
 /// Encodes a PNG in memory for the tests.
 pub(crate) fn encode_png(
