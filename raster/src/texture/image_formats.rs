@@ -42,6 +42,16 @@ pub(super) fn decode_with_image(
         message: format!("{} decoding failed: {e}", format.name()),
         source: Some(TextureSource::Image(e)),
     };
+    // PNG's size sits at a fixed place in the first chunk, which the decoder only reports
+    // after reading on to the image data: check it first, so that a header claiming an absurd
+    // size is named as such even when the rest of the file is missing.
+    if format == TextureFormat::Png
+        && let Some((width, height)) = png_header_size(bytes)
+    {
+        limits
+            .check(width, height)
+            .map_err(|m| TextureError::new(path, m))?;
+    }
     let mut reader = ImageReader::with_format(Cursor::new(bytes), image_format);
     let mut image_limits = image::Limits::default();
     // The largest buffer a capped image needs: RGBA at 32-bit float, plus headroom for tables.
@@ -70,6 +80,18 @@ pub(super) fn decode_with_image(
         )
     })?;
     Ok((width, height, texels))
+}
+
+/// The width and height in a PNG's IHDR chunk (the first chunk, right after the 8-byte
+/// signature: length, `IHDR`, then width and height as big-endian u32), if present.
+fn png_header_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    if bytes.get(12..16)? != b"IHDR" {
+        return None;
+    }
+    let be = |at: usize| -> Option<u32> {
+        Some(u32::from_be_bytes(bytes.get(at..at + 4)?.try_into().ok()?))
+    };
+    Some((be(16)?, be(20)?))
 }
 
 /// Converts every pixel layout the five codecs produce; `None` for any other.
