@@ -33,7 +33,7 @@ fn bless() -> bool {
 fn kd_codes(x: usize, y: usize) -> [u8; 3] {
     let warm = [224.0, 160.0, 128.0];
     let cool = [96.0, 160.0, 200.0];
-    let base = if (x / 16 + y / 16) % 2 == 0 {
+    let base = if (x / 16 + y / 16).is_multiple_of(2) {
         warm
     } else {
         cool
