@@ -529,6 +529,51 @@ def convexity_seeds():
     write(t, "plane-corner-lifted", shape(2, bytes([15, 31]), perturb=[(1, 4, 0, 5)], transform=bytes([1, 7, 8, 9])))
 
 
+# ----------------------------------------------------------------------- texture_load_never_panics
+def texture_seeds():
+    """Byte 0 picks the decoder (low 3 bits: 0-5 PNG, JPEG, TGA, BMP, HDR, OpenEXR forced;
+    6, 7 detected as t.png / t.tga), bit 3 data (linear) instead of colour; then the file."""
+    t = "texture_load_never_panics"
+    PNG, JPEG, TGA, BMP, HDR, EXR, DETECT_PNG, DETECT_TGA, DATA = 0, 1, 2, 3, 4, 5, 6, 7, 8
+
+    def shipped(name):
+        with open(os.path.join(ROOT, "scenes", "textures", name), "rb") as f:
+            return f.read()
+
+    # 3 x 2 RGB, rows top first.
+    rgb = [(255, 0, 0), (0, 128, 0), (0, 0, 64), (10, 20, 30), (188, 188, 188), (1, 254, 127)]
+
+    def tga(kind, bits, descriptor, body):
+        return bytes([0, 0, kind, 0, 0, 0, 0, 0, 0, 0, 0, 0]) + u16(3) + u16(2) + bytes([bits, descriptor]) + body
+
+    bottom_up = rgb[3:] + rgb[:3]
+    tga_raw = tga(2, 24, 0, b"".join(bytes([b, g, r]) for r, g, b in bottom_up))
+    # Run-length encoded (type 10), top-down: a run of 3, then 3 raw pixels.
+    tga_rle = tga(10, 24, 0x20, bytes([0x82, 64, 32, 16, 0x02]) + b"".join(bytes([b, g, r]) for r, g, b in rgb[3:]))
+    row_pad = b"\0\0\0"
+    bmp_pixels = b"".join(b"".join(bytes([b, g, r]) for r, g, b in row) + row_pad for row in (rgb[3:], rgb[:3]))
+    bmp = (b"BM" + u32(54 + len(bmp_pixels)) + u32(0) + u32(54) + u32(40) + u32(3) + u32(2)
+           + u16(1) + u16(24) + u32(0) + u32(len(bmp_pixels)) + u32(2835) + u32(2835) + u32(0) + u32(0)
+           + bmp_pixels)
+    hdr = (b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n"
+           + bytes([128, 64, 32, 129, 0, 0, 0, 0, 200, 1, 255, 140, 128, 128, 128, 128]))
+    # Width 8: new-style run-length scan lines (per channel: a run of 8, then one of 8 for E).
+    hdr_rle = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 8\n" + bytes([2, 2, 0, 8]) + bytes(
+        [128 + 8, 100, 128 + 8, 50, 128 + 8, 25, 128 + 8, 129])
+    write(t, "png-ramp", bytes([PNG]) + shipped("mfp-ramp.png"))
+    write(t, "png-ramp-detected-data", bytes([DETECT_PNG | DATA]) + shipped("mfp-ramp.png"))
+    write(t, "jpeg-checker", bytes([JPEG]) + shipped("kd-checker.jpg"))
+    write(t, "jpeg-checker-detected", bytes([DETECT_PNG]) + shipped("kd-checker.jpg"))
+    write(t, "tga-bottom-up", bytes([TGA]) + tga_raw)
+    write(t, "tga-rle-detected-data", bytes([DETECT_TGA | DATA]) + tga_rle)
+    write(t, "bmp-padded-rows", bytes([BMP]) + bmp)
+    write(t, "hdr-flat", bytes([HDR]) + hdr)
+    write(t, "hdr-rle-detected", bytes([DETECT_TGA]) + hdr_rle)
+    write(t, "exr-disc-data", bytes([EXR | DATA]) + shipped("mfp-disc.exr"))
+    write(t, "exr-disc-detected", bytes([DETECT_PNG]) + shipped("mfp-disc.exr"))
+    write(t, "unrecognised-text", bytes([DETECT_PNG]) + b"not an image")
+
+
 if __name__ == "__main__":
     cache_seeds()
     table_seeds()
@@ -539,3 +584,4 @@ if __name__ == "__main__":
     raster_seeds()
     shadow_seeds()
     convexity_seeds()
+    texture_seeds()

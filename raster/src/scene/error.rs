@@ -35,7 +35,7 @@ pub enum SceneErrorKind {
     Conflict,
     /// A mesh that cannot be used: malformed OBJ, bad indices, NaN vertices, no area, no UVs.
     Mesh,
-    /// A texture that cannot be used: malformed PNG, absurd size.
+    /// A texture that cannot be used: a malformed or unsupported image file, absurd size.
     Texture,
 }
 

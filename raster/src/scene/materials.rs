@@ -67,7 +67,7 @@ impl<'o> TextureCache<'o> {
             )
             .with_source(why)
         })?;
-        let texture = Texture::from_png_bytes(&bytes, &path, encoding).map_err(|e| {
+        let texture = Texture::from_bytes(&bytes, &path, encoding).map_err(|e| {
             c.at(SceneErrorKind::Texture, key, file, e.to_string())
                 .with_source(e)
         })?;

@@ -16,6 +16,7 @@
 //! | [`raster_triangle_in_bounds`] | arbitrary clip-space triangles → coverage and depth as an oracle says |
 //! | [`shadow_rays_match_brute_force`] | BVH any-hit (plain, hinted) and closest hit against a brute-force loop |
 //! | [`convexity_is_sound`] | a mesh `cannot_shadow_itself` accepts is flat or convex by an exhaustive check |
+//! | [`texture_load_never_panics`] | arbitrary bytes as each texture format → a texture within the caps or an error |
 
 mod cache;
 mod convexity;
@@ -25,6 +26,7 @@ mod parse;
 mod raster;
 mod shadow;
 mod table;
+mod texture;
 
 pub use cache::{MAX_FUZZ_SAMPLES, cache_query_matches_exhaustive};
 pub use convexity::convexity_is_sound;
@@ -33,12 +35,13 @@ pub use parse::{SMALL_MESH_OBJ, fuzz_origin, obj_load_never_panics, scene_parse_
 pub use raster::raster_triangle_in_bounds;
 pub use shadow::shadow_rays_match_brute_force;
 pub use table::table_lookup_finite;
+pub use texture::{FUZZ_LIMITS, texture_load_never_panics};
 
 /// A property: takes the fuzzer's bytes, panics when the property fails.
 pub type Property = fn(&[u8]);
 
 /// Every target by name, with its property: what the replay test and tools iterate over.
-pub const TARGETS: [(&str, Property); 9] = [
+pub const TARGETS: [(&str, Property); 10] = [
     (
         "cache_query_matches_exhaustive",
         cache_query_matches_exhaustive,
@@ -54,4 +57,5 @@ pub const TARGETS: [(&str, Property); 9] = [
         shadow_rays_match_brute_force,
     ),
     ("convexity_is_sound", convexity_is_sound),
+    ("texture_load_never_panics", texture_load_never_panics),
 ];

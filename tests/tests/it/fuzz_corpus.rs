@@ -91,6 +91,11 @@ fn convexity_is_sound() {
     replay("convexity_is_sound");
 }
 
+#[test]
+fn texture_load_never_panics() {
+    replay("texture_load_never_panics");
+}
+
 /// Every fuzz target has a property and a corpus, and every corpus a target: a target added
 /// without its replay (or a misspelt directory) fails here.
 #[test]

@@ -1,9 +1,9 @@
 //! Deterministic golden-image tests.
 //!
-//! Nine small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u plane,
-//! an opaque-only scene, the rect light, the environment map, an OBJ with two materials (K_d
-//! from its `.mtl`), a binary-PLY bunny and a glTF egg under a node hierarchy — are rendered
-//! and compared with files committed under
+//! Eleven small scenes — the default scene, the sphere shadow edge, the texture-mapped ℓ_u
+//! plane, an opaque-only scene, the rect light, the environment map, an OBJ with two materials
+//! (K_d from its `.mtl`), a binary-PLY bunny, a glTF egg under a node hierarchy, a JPEG K_d
+//! texture and an OpenEXR ℓ_u texture — are rendered and compared with files committed under
 //! `tests/golden/`:
 //!
 //! - `<name>.coverage.png`: the supersampled visibility buffer (triangle id + 1 as 24-bit RGB,
@@ -88,6 +88,14 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         (
             "gltf-egg",
             small(load("tests/data/gltf-egg.toml"), 64, 2000),
+        ),
+        (
+            "textured-kd-jpeg",
+            small(load("scenes/textured-kd-jpeg.toml"), 64, 3000),
+        ),
+        (
+            "textured-mfp-exr",
+            small(load("scenes/textured-mfp-exr.toml"), 64, 3000),
         ),
     ]
 }

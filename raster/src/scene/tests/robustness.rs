@@ -86,7 +86,7 @@ fn obj_and_png_mutations(objs: usize, pngs: usize) {
         let r = rng.next();
         let at = (r % m.len() as u64) as usize;
         m[at] = (r >> 32) as u8;
-        let _ = Texture::from_png_bytes(&m, Path::new("x.png"), TextureEncoding::Srgb);
+        let _ = Texture::from_bytes(&m, Path::new("x.png"), TextureEncoding::Srgb);
     }
 }
 

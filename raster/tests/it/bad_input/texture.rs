@@ -1,5 +1,6 @@
-//! PNG textures: missing, not PNG, absurd sizes in the header, truncated, corrupt, and
-//! textures on a mesh without UVs.
+//! Textures: missing, of no supported format, undecodable, absurd sizes in the header,
+//! truncated or corrupt PNG, JPEG and OpenEXR textures that render, and textures on a mesh
+//! without UVs.
 
 use super::harness::{
     CONSTANT, SPHERE, Sandbox, png_chunk, png_header_only, render, scene, valid_png,
@@ -44,8 +45,9 @@ fn missing_texture() {
     }
 }
 
-/// Files that are not PNG, or whose header claims an empty or absurd size: rejected before
-/// anything is allocated, naming the texture.
+/// Files of no supported format, that do not decode, or whose header claims an empty or absurd
+/// size: rejected before anything is allocated, naming the texture. The content decides the
+/// decoder, whatever the name.
 #[test]
 fn textures_of_the_wrong_format_or_size() {
     let jpeg: Vec<u8> = [
@@ -57,19 +59,23 @@ fn textures_of_the_wrong_format_or_size() {
     let exr = [0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, 0, 0, 0, 0];
     let cases: Vec<(&str, Vec<u8>, &[&str])> = vec![
         (
-            "a JPEG named .png",
+            "a broken JPEG named .png",
             jpeg,
-            &["not a readable PNG", "signature"],
+            &["JPEG decoding failed: "],
         ),
         (
-            "an OpenEXR named .png",
+            "a broken OpenEXR named .png",
             exr.to_vec(),
-            &["not a readable PNG"],
+            &["OpenEXR decoding failed: "],
         ),
-        ("text", b"not an image\n".to_vec(), &["not a readable PNG"]),
-        ("empty", Vec::new(), &["PNG"]),
-        ("0 × 0", png_header_only(0, 0), &["PNG"]),
-        ("0 × 16", png_header_only(0, 16), &["PNG"]),
+        (
+            "text",
+            b"not an image\n".to_vec(),
+            &["not a PNG, JPEG, BMP, Radiance HDR or OpenEXR file (it starts with 6e 6f 74"],
+        ),
+        ("empty", Vec::new(), &["texture kd.png: empty file"]),
+        ("0 × 0", png_header_only(0, 0), &["empty image (0 × 0)"]),
+        ("0 × 16", png_header_only(0, 16), &["empty image (0 × 16)"]),
         (
             "100000 × 100000",
             png_header_only(100_000, 100_000),
@@ -85,7 +91,11 @@ fn textures_of_the_wrong_format_or_size() {
             png_header_only(0x7fff_ffff, 1),
             &["2147483647 × 1", "larger than 16384 texels per side"],
         ),
-        ("4 × 4 without pixel data", png_header_only(4, 4), &["PNG"]),
+        (
+            "4 × 4 without pixel data",
+            png_header_only(4, 4),
+            &["PNG decoding failed: ", "IDAT"],
+        ),
     ];
     for material in [KD_TEXTURE, ELL_TEXTURE] {
         let sb = texture_sandbox("texture-format", material);
@@ -101,6 +111,41 @@ fn textures_of_the_wrong_format_or_size() {
         std::fs::create_dir(sb.path("kd.png")).unwrap();
         sb.fails(&render(&[]), 1, &["cannot read texture kd.png"]);
     }
+}
+
+/// JPEG, TGA and OpenEXR textures (the shipped scenes' files and a hand-made TGA) render as
+/// colour and as data, whatever their names say.
+#[test]
+fn jpeg_tga_and_exr_textures_render() {
+    let jpeg = include_bytes!("../../../../scenes/textures/kd-checker.jpg").to_vec();
+    let exr = include_bytes!("../../../../scenes/textures/mfp-disc.exr").to_vec();
+    // 2 × 1 uncompressed true-colour TGA: B, G, R per pixel.
+    let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 24, 0];
+    tga.extend_from_slice(&[40, 80, 160, 200, 100, 50]);
+    for (file, bytes) in [
+        ("kd.jpg", &jpeg),
+        ("kd.png", &jpeg),
+        ("kd.tga", &tga),
+        ("kd.exr", &exr),
+    ] {
+        for material in [KD_TEXTURE, ELL_TEXTURE] {
+            let material = material.replace("kd.png", file);
+            let sb = Sandbox::with_scene("texture-formats", &scene(SPHERE, &material));
+            sb.write(file, bytes);
+            sb.succeeds(&render(&[]));
+        }
+    }
+    // The same TGA bytes without the extension that identifies them: refused, naming both.
+    let sb = texture_sandbox("texture-formats", KD_TEXTURE);
+    sb.write("kd.png", &tga);
+    sb.fails(
+        &render(&[]),
+        1,
+        &[
+            "texture kd.png: not a PNG, JPEG, BMP, Radiance HDR or OpenEXR file",
+            "nor named .tga",
+        ],
+    );
 }
 
 /// A valid PNG cut at every byte: each prefix is an error naming the texture (the decoder

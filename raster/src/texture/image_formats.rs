@@ -1,0 +1,127 @@
+//! PNG, JPEG, TGA, BMP and Radiance HDR, through the `image` crate (built with exactly these
+//! five codecs).
+//!
+//! The header is read first and its size checked against the [`TextureLimits`] before any pixel
+//! memory exists; the decoder's own allocation cap (`image::Limits::max_alloc`) is a second
+//! line behind it. Decoded pixels of every layout the codecs produce (grey, grey + alpha, RGB,
+//! RGBA; 8 bits, 16 bits, 32-bit float) become linear RGB: grey is replicated, alpha dropped,
+//! integer codes normalised (`code / (2^bits − 1)`) and then decoded by the
+//! [`TextureEncoding`]; float samples are taken as they are.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use glam::Vec3;
+use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
+
+use super::{TextureEncoding, TextureError, TextureFormat, TextureLimits, TextureSource, decode};
+
+/// The decoded size and texels (row-major, top row first).
+pub(super) type Decoded = (u32, u32, Vec<Vec3>);
+
+/// Decodes `bytes` as `format` (not [`TextureFormat::Exr`]).
+pub(super) fn decode_with_image(
+    bytes: &[u8],
+    path: &Path,
+    format: TextureFormat,
+    encoding: TextureEncoding,
+    limits: &TextureLimits,
+) -> Result<Decoded, TextureError> {
+    let image_format = match format {
+        TextureFormat::Png => ImageFormat::Png,
+        TextureFormat::Jpeg => ImageFormat::Jpeg,
+        TextureFormat::Tga => ImageFormat::Tga,
+        TextureFormat::Bmp => ImageFormat::Bmp,
+        TextureFormat::Hdr => ImageFormat::Hdr,
+        TextureFormat::Exr => {
+            return Err(TextureError::new(path, "OpenEXR is not an `image` format"));
+        }
+    };
+    let failed = |e: image::ImageError| TextureError {
+        path: path.to_path_buf(),
+        message: format!("{} decoding failed: {e}", format.name()),
+        source: Some(TextureSource::Image(e)),
+    };
+    // PNG's size sits at a fixed place in the first chunk, which the decoder only reports
+    // after reading on to the image data: check it first, so that a header claiming an absurd
+    // size is named as such even when the rest of the file is missing.
+    if format == TextureFormat::Png
+        && let Some((width, height)) = png_header_size(bytes)
+    {
+        limits
+            .check(width, height)
+            .map_err(|m| TextureError::new(path, m))?;
+    }
+    let mut reader = ImageReader::with_format(Cursor::new(bytes), image_format);
+    let mut image_limits = image::Limits::default();
+    // The largest buffer a capped image needs: RGBA at 32-bit float, plus headroom for tables.
+    image_limits.max_alloc = Some(limits.max_texels.saturating_mul(16) + (1 << 20));
+    reader.limits(image_limits);
+    let decoder = reader.into_decoder().map_err(failed)?;
+    let (width, height) = decoder.dimensions();
+    limits
+        .check(width, height)
+        .map_err(|m| TextureError::new(path, m))?;
+    let image = DynamicImage::from_decoder(decoder).map_err(failed)?;
+    if (image.width(), image.height()) != (width, height) {
+        return Err(TextureError::new(
+            path,
+            format!(
+                "decoded {} × {} pixels, the header says {width} × {height}",
+                image.width(),
+                image.height()
+            ),
+        ));
+    }
+    let texels = linear_texels(image, encoding).ok_or_else(|| {
+        TextureError::new(
+            path,
+            format!("{} decoder returned an unknown pixel layout", format.name()),
+        )
+    })?;
+    Ok((width, height, texels))
+}
+
+/// The width and height in a PNG's IHDR chunk (the first chunk, right after the 8-byte
+/// signature: length, `IHDR`, then width and height as big-endian u32), if present.
+fn png_header_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    if bytes.get(12..16)? != b"IHDR" {
+        return None;
+    }
+    let be = |at: usize| -> Option<u32> {
+        Some(u32::from_be_bytes(bytes.get(at..at + 4)?.try_into().ok()?))
+    };
+    Some((be(16)?, be(20)?))
+}
+
+/// Converts every pixel layout the five codecs produce; `None` for any other.
+fn linear_texels(image: DynamicImage, encoding: TextureEncoding) -> Option<Vec<Vec3>> {
+    let lut8: Vec<f32> = (0..256u32)
+        .map(|c| decode(c as f32 / 255.0, encoding))
+        .collect();
+    let code8 = |c: u8| lut8[usize::from(c)];
+    let code16 = |c: u16| decode(f32::from(c) / f32::from(u16::MAX), encoding);
+    let rgb = |p: [f32; 3]| Vec3::from_array(p);
+    Some(match image {
+        DynamicImage::ImageLuma8(b) => b.pixels().map(|p| Vec3::splat(code8(p.0[0]))).collect(),
+        DynamicImage::ImageLumaA8(b) => b.pixels().map(|p| Vec3::splat(code8(p.0[0]))).collect(),
+        DynamicImage::ImageRgb8(b) => b.pixels().map(|p| rgb(p.0.map(code8))).collect(),
+        DynamicImage::ImageRgba8(b) => b
+            .pixels()
+            .map(|p| rgb([p.0[0], p.0[1], p.0[2]].map(code8)))
+            .collect(),
+        DynamicImage::ImageLuma16(b) => b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect(),
+        DynamicImage::ImageLumaA16(b) => b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect(),
+        DynamicImage::ImageRgb16(b) => b.pixels().map(|p| rgb(p.0.map(code16))).collect(),
+        DynamicImage::ImageRgba16(b) => b
+            .pixels()
+            .map(|p| rgb([p.0[0], p.0[1], p.0[2]].map(code16)))
+            .collect(),
+        // Floating-point samples (Radiance HDR) are linear values: no encoding applies.
+        DynamicImage::ImageRgb32F(b) => b.pixels().map(|p| rgb(p.0)).collect(),
+        DynamicImage::ImageRgba32F(b) => {
+            b.pixels().map(|p| rgb([p.0[0], p.0[1], p.0[2]])).collect()
+        }
+        _ => return None,
+    })
+}

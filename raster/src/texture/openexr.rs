@@ -1,0 +1,128 @@
+//! OpenEXR textures through the `exr` crate: linear float data, read as it is stored.
+//!
+//! The first part (layer) of the file is used, at its largest resolution level. Its channels
+//! are chosen by name: `R`, `G`, `B` if all three exist; otherwise `Y` (luminance), or the one
+//! channel of a single-channel part other than `A`, used for all three. Half, float and
+//! unsigned-int samples are converted to `f32` by value. Sub-sampled channels are not full-size
+//! images and are not used. Deep data is rejected.
+//!
+//! Before anything is decoded, the headers are read and every part's size checked against the
+//! [`TextureLimits`], and the samples of all parts together against four channels of the
+//! largest allowed texture, so that a header cannot make the decoder allocate without bound.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use exr::prelude::{FlatSamples, MetaData, ReadChannels, ReadLayers};
+use glam::Vec3;
+
+use super::image_formats::Decoded;
+use super::{TextureError, TextureLimits, TextureSource};
+
+/// Decodes an OpenEXR file held in memory.
+pub(super) fn decode_exr(
+    bytes: &[u8],
+    path: &Path,
+    limits: &TextureLimits,
+) -> Result<Decoded, TextureError> {
+    let failed = |e: exr::error::Error| TextureError {
+        path: path.to_path_buf(),
+        message: format!("OpenEXR decoding failed: {e}"),
+        source: Some(TextureSource::Exr(e)),
+    };
+    let meta = MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(failed)?;
+    let Some(first) = meta.headers.first() else {
+        return Err(TextureError::new(path, "OpenEXR file without parts"));
+    };
+    let size = |h: &exr::meta::header::Header| (h.layer_size.0, h.layer_size.1);
+    let (width, height) = size(first);
+    let (width, height) = (
+        u32::try_from(width).unwrap_or(u32::MAX),
+        u32::try_from(height).unwrap_or(u32::MAX),
+    );
+    limits
+        .check(width, height)
+        .map_err(|m| TextureError::new(path, m))?;
+    let mut samples = 0u64;
+    for header in meta.headers.iter() {
+        let (w, h) = size(header);
+        let channels = header.channels.list.len() as u64;
+        samples =
+            samples.saturating_add((w as u64).saturating_mul(h as u64).saturating_mul(channels));
+    }
+    let max_samples = limits.max_texels.saturating_mul(4);
+    if samples > max_samples {
+        return Err(TextureError::new(
+            path,
+            format!(
+                "OpenEXR file holds {samples} samples in all, more than the {max_samples} \
+                 (four channels of the largest texture) lucent reads"
+            ),
+        ));
+    }
+
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .non_parallel()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(failed)?;
+    let layer = image.layer_data;
+    if (layer.size.0, layer.size.1) != (width as usize, height as usize) {
+        return Err(TextureError::new(
+            path,
+            format!(
+                "decoded {} × {} pixels, the header says {width} × {height}",
+                layer.size.0, layer.size.1
+            ),
+        ));
+    }
+    let texels = width as usize * height as usize;
+    // Full-size channels by name.
+    let channels: Vec<(String, &FlatSamples)> = layer
+        .channel_data
+        .list
+        .iter()
+        .filter(|c| c.sample_data.len() == texels)
+        .map(|c| (c.name.to_string(), &c.sample_data))
+        .collect();
+    let find = |name: &str| channels.iter().find(|(n, _)| n == name).map(|(_, s)| *s);
+    let values = |s: &FlatSamples| s.values_as_f32().collect::<Vec<f32>>();
+    let texels = if let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) {
+        let (r, g, b) = (values(r), values(g), values(b));
+        (0..texels).map(|i| Vec3::new(r[i], g[i], b[i])).collect()
+    } else {
+        let non_alpha: Vec<&(String, &FlatSamples)> =
+            channels.iter().filter(|(n, _)| n != "A").collect();
+        let grey = find("Y").or(match non_alpha.as_slice() {
+            [(_, only)] => Some(*only),
+            _ => None,
+        });
+        let Some(grey) = grey else {
+            let names: Vec<String> = layer
+                .channel_data
+                .list
+                .iter()
+                .take(16)
+                .map(|c| c.name.to_string())
+                .collect();
+            return Err(TextureError::new(
+                path,
+                format!(
+                    "OpenEXR part has no R, G, B channels, no Y channel and not exactly one \
+                     other full-size channel (channels: {})",
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                ),
+            ));
+        };
+        values(grey).into_iter().map(Vec3::splat).collect()
+    };
+    Ok((width, height, texels))
+}
