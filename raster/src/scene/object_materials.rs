@@ -101,6 +101,37 @@ impl From<&ObjMesh> for ObjGroups {
     }
 }
 
+impl ObjGroups {
+    /// A glTF file's primitives as groups: each material name is a group (in first-use order),
+    /// primitives without a name take the default material; there is no `.mtl`.
+    pub fn from_gltf(primitives: &[super::gltf::MaterialGroup], triangles: usize) -> Self {
+        let mut groups: Vec<String> = Vec::new();
+        let mut triangle_groups = vec![None; triangles];
+        for primitive in primitives {
+            let Some(name) = &primitive.material else {
+                continue;
+            };
+            let g = match groups.iter().position(|n| n == name) {
+                Some(g) => g,
+                None => {
+                    groups.push(name.clone());
+                    groups.len() - 1
+                }
+            };
+            for t in primitive.triangles.clone() {
+                if let Some(slot) = triangle_groups.get_mut(t) {
+                    *slot = Some(g as u32);
+                }
+            }
+        }
+        ObjGroups {
+            groups,
+            triangle_groups,
+            mtllibs: Vec::new(),
+        }
+    }
+}
+
 /// Where the object's mesh came from: the key, its span and the file (or shape) name.
 pub(crate) type SourceKey = (String, std::ops::Range<usize>, String);
 

@@ -9,11 +9,12 @@ use toml::Spanned;
 use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::RawObject;
+use super::gltf::{GltfMesh, parse_gltf};
 use super::mesh::{Transform, validate_mesh};
 use super::mesh_file::{MESH_EXTENSIONS, MeshFileError, MeshFormat, parse_mesh_file};
 use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
-use super::object_materials::{MaterialTable, ObjGroups, split_by_material};
+use super::object_materials::{MaterialRef, MaterialTable, ObjGroups, split_by_material};
 use super::origin::SceneOrigin;
 use super::sanity::{normals_against_winding, orient_outward};
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
@@ -122,8 +123,33 @@ pub(crate) fn build_object(
                     groups = Some(ObjGroups::from(&obj));
                     (obj.mesh, obj.warnings)
                 }
+                Loaded::Gltf(gltf) => {
+                    let mtl = |r: &MaterialRef| r.kd_from_mtl;
+                    let mapped_mtl = o
+                        .materials
+                        .iter()
+                        .flat_map(|m| m.get_ref().values())
+                        .any(|name| table.by_name.get(name.get_ref().as_str()).is_some_and(mtl));
+                    if mtl(&material) || mapped_mtl {
+                        return Err(c.at(
+                            SceneErrorKind::Conflict,
+                            &key(name),
+                            file,
+                            "a material with kd = \"mtl\" reads an OBJ's .mtl; glTF materials \
+                             give no map_Kd to lucent",
+                        ));
+                    }
+                    groups = Some(ObjGroups::from_gltf(
+                        &gltf.groups,
+                        gltf.mesh.triangles.len(),
+                    ));
+                    let mut mesh = gltf.mesh;
+                    let flipped = orient_outward(&mut mesh, true);
+                    let against = normals_against_winding(&mesh);
+                    (mesh, flipped.into_iter().chain(against).collect())
+                }
                 Loaded::Other(mut mesh) => {
-                    c.forbid(&key("materials"), &o.materials, "a PLY or glTF mesh")?;
+                    c.forbid(&key("materials"), &o.materials, "a PLY mesh")?;
                     // The same repairs as for OBJ files. The normals are the file's or were
                     // computed from the winding: either way they follow the flip when they
                     // agreed with the inverted winding.
@@ -214,9 +240,11 @@ fn crease_angle(c: &Check, index: usize, o: &RawObject) -> Checked<Option<f32>> 
     }
 }
 
-/// A mesh file as read: an OBJ keeps its `usemtl` groups and repair warnings.
+/// A mesh file as read: an OBJ keeps its `usemtl` groups and repair warnings, a glTF its
+/// primitives' material names.
 enum Loaded {
     Obj(ObjMesh),
+    Gltf(GltfMesh),
     Other(Mesh),
 }
 
@@ -277,6 +305,11 @@ fn load_mesh(
                 )
             })
     };
+    if format == MeshFormat::Gltf {
+        return parse_gltf(&bytes, &mut read_file)
+            .map(Loaded::Gltf)
+            .map_err(|e| located(MeshFileError::Gltf(e)));
+    }
     parse_mesh_file(format, &bytes, &mut read_file)
         .map(Loaded::Other)
         .map_err(located)

@@ -47,6 +47,43 @@ const LIB: &str = "newmtl a\nmap_Kd tex/a.png\nnewmtl b\nKd 1 0 0\n";
 const INSIDE_OUT: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
     f 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n";
 
+/// A unit quad as two glTF primitives, one triangle each, with materials `wax` and `jade`.
+fn two_material_gltf() -> Vec<u8> {
+    use base64::Engine as _;
+    let mut buffer = Vec::new();
+    for p in [
+        [0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ] {
+        for v in p {
+            buffer.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        buffer.extend_from_slice(&i.to_le_bytes());
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&buffer);
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+  "nodes": [{{"mesh": 0}}],
+  "meshes": [{{"primitives": [
+    {{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 0}},
+    {{"attributes": {{"POSITION": 0}}, "indices": 2, "material": 1}}]}}],
+  "materials": [{{"name": "wax"}}, {{"name": "jade"}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+      "min": [0, 0, 0], "max": [1, 1, 0]}},
+    {{"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}},
+    {{"bufferView": 1, "byteOffset": 6, "componentType": 5123, "count": 3, "type": "SCALAR"}}],
+  "bufferViews": [{{"buffer": 0, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 48, "byteLength": 12}}],
+  "buffers": [{{"byteLength": 60, "uri": "data:application/octet-stream;base64,{data}"}}]}}"#
+    )
+    .into_bytes()
+}
+
 fn origin() -> SceneOrigin {
     let (rgb, eight) = (png::ColorType::Rgb, png::BitDepth::Eight);
     let png = encode_png(2, 1, rgb, eight, &[200, 100, 50, 50, 100, 200], None);
@@ -63,6 +100,7 @@ fn origin() -> SceneOrigin {
             GROUPS.replace("mtllib lib.mtl\n", "").into(),
         ),
         ("m/inside-out.obj", INSIDE_OUT.into()),
+        ("m/two.gltf", two_material_gltf()),
         (
             "m/inside-out.ply",
             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
@@ -364,4 +402,30 @@ fn weld_and_crease_angle_smooth_a_faceted_mesh() {
         let (_, shown, e) = object_error(object);
         assert_eq!(e.kind, kind, "{shown}");
     }
+}
+
+/// glTF primitives' material names map like OBJ groups: one object per scene material; a
+/// `kd = "mtl"` material cannot apply to a glTF mesh.
+#[test]
+fn gltf_material_names_map_to_scene_materials() {
+    let s = scene(
+        "name = \"g\"\nmesh = \"m/two.gltf\"\nmaterial = \"plain\"\n\
+         materials = { jade = \"dark\" }\n",
+    )
+    .unwrap();
+    let names: Vec<_> = s.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["g/plain", "g/dark"]);
+    assert_eq!(material_name(&s, 0), "plain");
+    assert_eq!(material_name(&s, 1), "dark");
+    assert!(s.objects.iter().all(|o| o.mesh.triangles.len() == 1));
+    // `wax` is not mapped: a warning, and the default material.
+    assert!(
+        s.warnings.iter().any(|w| w.contains("wax")),
+        "{:?}",
+        s.warnings
+    );
+    let err =
+        scene("mesh = \"m/two.gltf\"\nmaterial = \"plain\"\nmaterials = { wax = \"skin\" }\n")
+            .unwrap_err();
+    assert!(err.to_string().contains("kd = \"mtl\""), "{err}");
 }
