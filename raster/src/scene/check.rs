@@ -1,5 +1,6 @@
 //! Value checks with located errors: every number read from a scene passes through here, so
-//! NaN, infinities and out-of-range values are reported with their file, line and key.
+//! NaN, infinities and out-of-range values are reported with their file, line and key, and the
+//! value as the file writes it (`1e39`, not `1000000000000000000000000000000000000000`).
 
 use glam::Vec3;
 use toml::Spanned;
@@ -45,10 +46,18 @@ impl<'a> Check<'a> {
         let x = *v.get_ref();
         let y = x as f32;
         if !x.is_finite() {
-            return Err(self.range(key, v, format!("must be a finite number (got {x})")));
+            return Err(self.range(
+                key,
+                v,
+                format!("must be a finite number (got {})", self.written(v)),
+            ));
         }
         if !y.is_finite() {
-            return Err(self.range(key, v, format!("{x} is too large")));
+            return Err(self.range(
+                key,
+                v,
+                format!("{} is too large for single precision", self.written(v)),
+            ));
         }
         Ok(y)
     }
@@ -65,7 +74,7 @@ impl<'a> Check<'a> {
         if ok(x) {
             Ok(x)
         } else {
-            Err(self.range(key, v, format!("{requirement} (got {})", v.get_ref())))
+            Err(self.range(key, v, format!("{requirement} (got {})", self.written(v))))
         }
     }
 
@@ -85,7 +94,11 @@ impl<'a> Check<'a> {
         if (lo..=hi).contains(&x) {
             Ok(x)
         } else {
-            Err(self.range(key, v, format!("must be in {lo}..={hi} (got {x})")))
+            Err(self.range(
+                key,
+                v,
+                format!("must be in {lo}..={hi} (got {})", self.written(v)),
+            ))
         }
     }
 
@@ -117,7 +130,7 @@ impl<'a> Check<'a> {
         if out.to_array().iter().all(|&x| ok(x)) {
             Ok(out)
         } else {
-            Err(self.range(key, v, format!("{requirement} (got {})", show(v.get_ref()))))
+            Err(self.range(key, v, format!("{requirement} (got {})", self.written(v))))
         }
     }
 
@@ -147,7 +160,7 @@ impl<'a> Check<'a> {
                     Err(self.range(
                         key,
                         v,
-                        format!("must be finite numbers (got {})", show(v.get_ref())),
+                        format!("must be finite numbers (got {})", self.written(v)),
                     ))
                 }
             })
@@ -183,19 +196,5 @@ impl<'a> Check<'a> {
                 format!("missing required key for {what}"),
             )
         })
-    }
-}
-
-/// Shows a raw number list the way it was written.
-fn show(c: &Components) -> String {
-    match c {
-        Components::Scalar(x) => format!("{x}"),
-        Components::List(l) => format!(
-            "[{}]",
-            l.iter()
-                .map(|x| format!("{x}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
     }
 }
