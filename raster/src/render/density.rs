@@ -210,9 +210,11 @@ impl DensityPlan {
         };
         let need = self.resolving_count();
         let fix = if need > u64::from(HARD_MAX) {
+            // In exponent form: the count itself can be beyond u64 (and saturated to it).
+            let estimate = resolving_estimate(self.area, f64::from(self.finest.ell_d));
             format!(
-                "resolving it takes about {need} samples, more than the limit of {HARD_MAX} \
-                 (check the scene's units and mm_per_unit)"
+                "resolving it takes about {estimate:.2e} samples, more than the limit of \
+                 {HARD_MAX} (check the scene's units and mm_per_unit)"
             )
         } else {
             let how = match self.origin {
@@ -257,9 +259,14 @@ impl std::fmt::Display for Sig {
 
 /// The count at spacing [`AUTO_SPACING`] · `ell_d` over `area`: ⌈A / ((√3/2) s²)⌉, saturated.
 pub fn resolving_count(area: f64, ell_d: f64) -> u64 {
-    let s = f64::from(AUTO_SPACING) * ell_d;
-    let n = (area / (0.75f64.sqrt() * s * s)).ceil();
+    let n = resolving_estimate(area, ell_d).ceil();
     if n.is_finite() { n as u64 } else { u64::MAX }
+}
+
+/// [`resolving_count`] before rounding and saturation: A / ((√3/2) s²).
+fn resolving_estimate(area: f64, ell_d: f64) -> f64 {
+    let s = f64::from(AUTO_SPACING) * ell_d;
+    area / (0.75f64.sqrt() * s * s)
 }
 
 /// The automatic count for `area` and `ell_d` under the cap `max`, and whether the cap cut it.
@@ -663,6 +670,13 @@ mod tests {
         let tiny = plan_with(DensityOrigin::Count, 23_000, 1e-4);
         let w = tiny.warning(Method::Exhaustive, 1.5).unwrap();
         assert!(w.contains("more than the limit of 33554432"), "{w}");
+        // 227 / (0.866 · (0.25e-4)²) = 4.19e11 samples, in exponent form.
+        assert!(w.contains("about 4.19e11 samples"), "{w}");
+        // Far beyond u64 (which the count saturates to), the estimate is still the estimate.
+        let absurd = plan_with(DensityOrigin::Count, 23_000, 1e-12);
+        let w = absurd.warning(Method::Exhaustive, 1.5).unwrap();
+        assert!(w.contains("about 4.19e27 samples"), "{w}");
+        assert!(!w.contains(&u64::MAX.to_string()), "{w}");
         // At or below ℓ_d: no warning, for any method.
         let fine = plan_with(DensityOrigin::Count, 23_000, 0.107);
         assert!(fine.ratio() <= WARN_SPACING);
