@@ -75,6 +75,7 @@
 extern crate alloc;
 
 mod cache;
+mod cell_average;
 mod dipole;
 pub mod error;
 mod fresnel;
@@ -98,6 +99,7 @@ mod table;
 pub use glam;
 
 pub use cache::{IrradianceCache, Sample};
+pub use cell_average::CellAverage;
 pub use dipole::Dipole;
 pub use kd_tables::LocalIntegralByKd;
 pub use local_term::LocalTerm;

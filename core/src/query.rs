@@ -21,7 +21,7 @@ use crate::kernel::Kernel;
 use crate::lanes::{DefaultLanes, Lanes};
 use crate::local_term::LocalTerm;
 use crate::profile::Profile;
-use crate::refine::EDGE_THRESHOLD;
+use crate::refine::{EDGE_THRESHOLD, uniform_within};
 use crate::stats::{NoStats, StatsSink};
 
 /// How a query sums the cache.
@@ -63,6 +63,13 @@ impl Method {
             Method::EdgeRefined => "edge-refined",
             Method::Exhaustive => "exhaustive",
         }
+    }
+
+    /// True for the method whose samples carry, where a shadow edge crosses their cell, the
+    /// mean irradiance over the cell ([`crate::CellAverage`]; edge-refined). The others keep
+    /// JB02's irradiance at the sample, as published.
+    pub fn averages_edge_cells(self) -> bool {
+        self == Method::EdgeRefined
     }
 
     /// True for the methods with a local term (LM07, N10, edge-refined), which need K and α.
@@ -333,7 +340,7 @@ impl IrradianceCache {
             Method::EdgeAware | Method::EdgeRefined => {
                 let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
                 let refine = settings.method == Method::EdgeRefined
-                    && !uniform(sums.irradiance_range, e, EDGE_THRESHOLD);
+                    && !uniform_within(sums.irradiance_range, e, EDGE_THRESHOLD);
                 // N10: the shading point joins the kernel-weighted average at r = 0 with weight
                 // Rd(0)·Ā, in (1/4, 1] in the traversal's scaled weights (0 if Ā = 0). The
                 // scaled flux sum is Σ w·Rd·E·A·rd_scale·flux_scale: times area_scale /
@@ -376,18 +383,6 @@ fn reciprocal_pow2(v: f32) -> f32 {
     let floor = ((bits >> 52) & 0x7ff) as i32 - 1023;
     let ceil = floor + i32::from(bits & ((1 << 52) - 1) != 0);
     crate::math::pow2i((-ceil).clamp(-126, 126))
-}
-
-/// The edge test of the edge-refined method: every sample within α (`range` = min, max of
-/// Σ_c E) within `threshold` of Σ_c E(x) (no samples within α: uniform). A dark x with dark
-/// samples is uniform; a dark x with any lit sample is not.
-fn uniform(range: (f32, f32), e: Vec3, threshold: f32) -> bool {
-    let (lo, hi) = range;
-    if lo > hi {
-        return true;
-    }
-    let ex = e.x + e.y + e.z;
-    lo >= (1.0 - threshold) * ex && hi * (1.0 - threshold) <= ex
 }
 
 fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {

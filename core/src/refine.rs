@@ -89,6 +89,18 @@ pub const DEFAULT_PER_RING: usize = 4;
 /// 53% more than edge-aware's, at 2× above and ½ below 18.7%).
 pub const EDGE_THRESHOLD: f32 = 0.5;
 
+/// The edge test: true when the irradiance sums in `range` (lowest, highest; an empty range,
+/// lowest > highest, is uniform) all lie in [(1 − τ)·E, E/(1 − τ)] of E = `e` summed over the
+/// channels, τ = `threshold`.
+pub(crate) fn uniform_within(range: (f32, f32), e: Vec3, threshold: f32) -> bool {
+    let (lo, hi) = range;
+    if lo > hi {
+        return true;
+    }
+    let ex = e.x + e.y + e.z;
+    lo >= (1.0 - threshold) * ex && hi * (1.0 - threshold) <= ex
+}
+
 /// Intervals of the tabulated radial distribution (uniform in √ρ).
 const INTERVALS: usize = 32;
 /// The sphere the nodes are lifted onto has this radius in units of α.

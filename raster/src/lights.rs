@@ -47,6 +47,8 @@ pub struct Lighting<'a> {
     scale: f32,
     /// How far along each shadow ray occluders are ignored (see [`Lighting::skipping`]).
     skip: f32,
+    /// Only the lights with hard shadows (see [`Lighting::hard_only`]).
+    hard_only: bool,
 }
 
 /// What one thread remembers between shadow rays: the last occluder of each of the first
@@ -64,6 +66,14 @@ impl ShadowHints {
     pub const LIGHTS: usize = 8;
 }
 
+/// Lights whose shadows are soft (penumbrae), left out by [`Lighting::hard_only`].
+fn is_soft(light: &Light) -> bool {
+    matches!(
+        light,
+        Light::Sphere { .. } | Light::Rect { .. } | Light::Environment { .. }
+    )
+}
+
 /// 1 − small, so that a shadow ray stops just short of a light it aims at.
 const SHORTEN: f32 = 1.0 - 1e-4;
 
@@ -75,7 +85,30 @@ impl<'a> Lighting<'a> {
             occluders,
             scale,
             skip: 0.0,
+            hard_only: false,
         }
+    }
+
+    /// The same lighting with only the lights whose shadows have hard edges: point, spot and
+    /// directional lights (a spot's cone is soft, its shadows are not). Sphere, rect and
+    /// environment lights are left out: their penumbrae are smooth at the scale of a sample's
+    /// cell or the smoothing radius, and each of their estimates costs `samples` rays. The
+    /// edge-refined method refines only what these lights deliver.
+    pub fn hard_only(self) -> Self {
+        Lighting {
+            hard_only: true,
+            ..self
+        }
+    }
+
+    /// True if some light's shadows have hard edges ([`Lighting::hard_only`] keeps it).
+    pub fn has_hard_lights(&self) -> bool {
+        self.lights.iter().any(|l| !is_soft(l))
+    }
+
+    /// True if some light is left out by [`Lighting::hard_only`].
+    pub fn has_soft_lights(&self) -> bool {
+        self.lights.iter().any(is_soft)
     }
 
     /// The same lights with shadow rays that ignore occluders within `distance` of the point
@@ -145,6 +178,9 @@ impl<'a> Lighting<'a> {
         mut f: impl FnMut(Incident),
     ) {
         for (index, light) in self.lights.iter().enumerate() {
+            if self.hard_only && is_soft(light) {
+                continue;
+            }
             let mut spare = ShadowHint::NONE;
             let hint = hints.per_light.get_mut(index).unwrap_or(&mut spare);
             let incident = match *light {
@@ -260,6 +296,9 @@ impl<'a> Lighting<'a> {
     pub fn reach_mask(&self, p: Vec3, n: Vec3, hints: &mut ShadowHints) -> u32 {
         let mut mask = 0;
         for (index, light) in self.lights.iter().enumerate().take(Self::MASK_LIGHTS) {
+            if self.hard_only && is_soft(light) {
+                continue;
+            }
             let mut spare = ShadowHint::NONE;
             let hint = hints.per_light.get_mut(index).unwrap_or(&mut spare);
             let towards = |target: Vec3, stop_short: f32, hint: &mut ShadowHint| {

@@ -45,6 +45,10 @@ pub struct RefinePoint {
 }
 
 /// `m` with its local term replaced by the quadrature of the irradiance over the α-disc.
+///
+/// Only the lights with hard shadows are traced at the nodes ([`Lighting::hard_only`]); the
+/// other lights' share of E(x) stands for theirs at every node. Without a hard-shadowed light
+/// `m` (edge-aware's result) is returned as it is.
 pub fn refine(
     lighting: &Lighting,
     quadrature: &LocalQuadrature,
@@ -52,16 +56,32 @@ pub fn refine(
     shadows: &mut ShadowHints,
     m: Exitance,
 ) -> Exitance {
+    if !lighting.has_hard_lights() {
+        return m;
+    }
     let (t1, t2) = point.normal.any_orthonormal_pair();
     let rotation = LocalQuadrature::rotation_for_seed(point.seed ^ 0x005E_ED0F_ED6E);
+    // The soft lights' share of E(x), the same at every node (none: the nodes' sums are the
+    // hard lights' alone, as without soft lights they are E(x′) itself).
+    let soft = lighting.has_soft_lights().then(|| {
+        let hard =
+            lighting
+                .hard_only()
+                .irradiance_with(point.position, point.normal, point.seed, shadows);
+        (point.irradiance - hard).max(Vec3::ZERO)
+    });
     // Occluders within α/2 of a node are the surface near x curving up, not a shadow's edge.
-    let lighting = lighting.skipping(quadrature.shadow_skip());
+    let lighting = lighting.hard_only().skipping(quadrature.shadow_skip());
     let mut at = [Vec3::ZERO; lucent_core::LocalQuadrature::MAX_NODES];
     for (n, e) in at.iter_mut().enumerate().take(quadrature.len()) {
         let o = quadrature.offset(n, rotation);
         let p = point.position + t1 * o.x + t2 * o.y + point.normal * quadrature.lift(n);
         let seed = splitmix64(point.seed.wrapping_add((n as u64 + 1) << 48));
-        *e = lighting.irradiance_with(p, point.normal, seed, shadows);
+        let hard = lighting.irradiance_with(p, point.normal, seed, shadows);
+        *e = match soft {
+            Some(soft) => soft + hard,
+            None => hard,
+        };
     }
     let local = quadrature.local_term(point.irradiance, point.local, &at[..quadrature.len()]);
     m.with_local(local, point.local)
@@ -168,5 +188,37 @@ mod tests {
             under >= 16,
             "{under} nodes under the wall: no test of the skip"
         );
+    }
+
+    /// Without a light with hard shadows nothing is traced: edge-aware's result comes back as
+    /// it is, even where the query flagged the point.
+    #[test]
+    fn soft_lights_alone_leave_edge_aware_s_result() {
+        let lights = [Light::Environment {
+            color: Vec3::ONE,
+            intensity: 1.0,
+            map: None,
+            rotation_degrees: 0.0,
+            samples: 16,
+        }];
+        let lighting = Lighting::new(&lights, None, 10.0);
+        let local = LocalTerm::exact(&marble(), 0.08).unwrap();
+        let point = RefinePoint {
+            position: Vec3::ZERO,
+            normal: Vec3::Z,
+            irradiance: Vec3::splat(3.0),
+            local,
+            seed: 5,
+        };
+        let m = Exitance {
+            local: Vec3::splat(0.25),
+            global: Vec3::splat(0.5),
+            total: Vec3::splat(0.75),
+            refine: true,
+            ..Exitance::default()
+        };
+        let q = quadrature(&marble(), 0.08);
+        let r = refine(&lighting, &q, &point, &mut ShadowHints::default(), m);
+        assert_eq!(r, m);
     }
 }

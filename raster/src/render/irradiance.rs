@@ -13,7 +13,7 @@
 //! diffuse from one object into another.
 
 use glam::{Vec2, Vec3};
-use lucent_core::{IrradianceCache, Sample};
+use lucent_core::{CellAverage, IrradianceCache, LocalQuadrature, Method, Sample};
 use rayon::prelude::*;
 
 use super::RenderError;
@@ -132,13 +132,17 @@ pub fn place_samples(
 }
 
 /// Irradiance at every sample (in parallel; each sample's value depends only on its index).
-/// Shadow rays use each object's own occluders ([`Prepared::occluders_for`]).
+/// Shadow rays use each object's own occluders ([`Prepared::occluders_for`]). With
+/// `method.averages_edge_cells()` (edge-refined), a sample whose cell a shadow edge crosses
+/// carries the mean over its cell ([`CellAverage`]).
 pub fn light_samples(
     prep: &Prepared,
     sets: &mut [ObjectSamples],
     lighting: &Lighting,
+    method: Method,
     progress: &indicatif::ProgressBar,
 ) {
+    let cells = method.averages_edge_cells().then(CellAverage::new);
     for set in sets.iter_mut() {
         let lighting = lighting.with_occluders(prep.occluders_for(set.object));
         let object = set.object as u64;
@@ -146,16 +150,95 @@ pub fn light_samples(
             .positions
             .par_iter()
             .zip(&set.normals)
+            .zip(&set.areas)
             .enumerate()
-            .map_init(ShadowHints::default, |hints, (i, (&p, &n))| {
-                let e =
-                    lighting.irradiance_with(p, n, splitmix64((object << 40) ^ i as u64), hints);
+            .map_init(ShadowHints::default, |hints, (i, ((&p, &n), &area))| {
+                let seed = splitmix64((object << 40) ^ i as u64);
+                let e = lighting.irradiance_with(p, n, seed, hints);
+                let e = match &cells {
+                    Some(cells) => {
+                        let sample = CellSample {
+                            position: p,
+                            normal: n,
+                            area,
+                            seed,
+                        };
+                        cell_irradiance(&lighting, cells, &sample, e, hints)
+                    }
+                    None => e,
+                };
                 if i % 1024 == 0 {
                     progress.inc(1024);
                 }
                 e
             })
             .collect();
+    }
+}
+
+/// One sample, as the cell rule sees it.
+struct CellSample {
+    position: Vec3,
+    normal: Vec3,
+    area: f32,
+    /// The sample's own light seed (the probes and nodes derive theirs from it).
+    seed: u64,
+}
+
+/// `e`, the irradiance at the sample, or, where a probe of its cell differs from the sample in
+/// which lights reach it ([`Lighting::reach_mask`]: a shadow's edge, a spot's cone), the mean
+/// over the cell ([`CellAverage`]; `docs/physics.md` §16). Only the lights with hard shadows
+/// are probed and averaged ([`Lighting::hard_only`]); the others' share of `e` is kept. The
+/// probes cost one shadow ray per light each.
+fn cell_irradiance(
+    lighting: &Lighting,
+    cells: &CellAverage,
+    sample: &CellSample,
+    e: Vec3,
+    hints: &mut ShadowHints,
+) -> Vec3 {
+    let rho = CellAverage::radius(sample.area);
+    if rho == 0.0 || !lighting.has_hard_lights() {
+        return e;
+    }
+    let (t1, t2) = sample.normal.any_orthonormal_pair();
+    let rotation = LocalQuadrature::rotation_for_seed(sample.seed ^ 0x00CE_11A7_E5A3);
+    // Occluders within ρ/2 of a point are the surface near the sample curving up.
+    let hard = lighting.hard_only().skipping(0.5 * rho);
+    let point = |offset: Vec2| {
+        sample.position
+            + t1 * offset.x
+            + t2 * offset.y
+            + sample.normal * CellAverage::lift(offset, rho)
+    };
+    let reach = hard.reach_mask(sample.position, sample.normal, hints);
+    let straddles = (0..CellAverage::PROBES).any(|k| {
+        let probe = point(cells.probe(k, rho, rotation));
+        hard.reach_mask(probe, sample.normal, hints) != reach
+    });
+    if !straddles {
+        return e;
+    }
+    let nodes: [Vec3; CellAverage::NODES] = core::array::from_fn(|j| {
+        let seed = splitmix64(sample.seed.wrapping_add((j as u64 + 1) << 48));
+        hard.irradiance_with(
+            point(cells.node(j, rho, rotation)),
+            sample.normal,
+            seed,
+            hints,
+        )
+    });
+    let mean = CellAverage::mean(&nodes);
+    if lighting.has_soft_lights() {
+        let at_centre = lighting.hard_only().irradiance_with(
+            sample.position,
+            sample.normal,
+            sample.seed,
+            hints,
+        );
+        (e - at_centre).max(Vec3::ZERO) + mean
+    } else {
+        mean
     }
 }
 
@@ -202,4 +285,113 @@ fn build_cache(object: usize, samples: &[Sample]) -> Result<IrradianceCache, Ren
              large, or lights too bright?)"
         ))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Bvh;
+    use crate::scene::Light;
+
+    /// An opaque plate over x < 0 at height 1, a directional light straight down: the shadow's
+    /// edge on the plane z = 0 is the line x = 0.
+    fn half_plane_shadow() -> (Vec<Light>, Bvh) {
+        let lights = vec![Light::Directional {
+            direction: -Vec3::Z,
+            color: Vec3::ONE,
+            irradiance: 1.0,
+        }];
+        let at = |x: f32, y: f32| Vec3::new(x, y, 1.0);
+        let plate = Bvh::build(&[
+            [at(-5.0, -5.0), at(0.0, -5.0), at(0.0, 5.0)],
+            [at(-5.0, -5.0), at(0.0, 5.0), at(-5.0, 5.0)],
+        ]);
+        (lights, plate)
+    }
+
+    fn sample(x: f32, rho: f32, seed: u64) -> CellSample {
+        CellSample {
+            position: Vec3::new(x, 0.3, 0.0),
+            normal: Vec3::Z,
+            area: core::f32::consts::PI * rho * rho,
+            seed,
+        }
+    }
+
+    /// A cell the edge crosses at distance d·ρ from its sample carries the lit fraction of its
+    /// disc, 1 − (θ − sin θ)/(2π) with θ = 2·acos(d) (the dark segment beyond the chord), on
+    /// average over the pattern's turns; a cell the edge misses keeps its sample's value bit
+    /// for bit.
+    #[test]
+    fn a_cell_across_a_shadow_edge_carries_its_lit_fraction() {
+        let (lights, plate) = half_plane_shadow();
+        let lighting = Lighting::new(&lights, Some(&plate), 10.0);
+        let cells = CellAverage::new();
+        let rho = 0.05;
+        let mut hints = ShadowHints::default();
+        for d in [-0.5f32, -0.2, 0.2, 0.5] {
+            let theta = 2.0 * f64::from(d).acos();
+            let lit = 1.0 - (theta - theta.sin()) / (2.0 * std::f64::consts::PI);
+            let turns = 200;
+            let mut sum = 0.0;
+            for seed in 0..turns {
+                let s = sample(d * rho, rho, seed);
+                let e = lighting.irradiance(s.position, s.normal, s.seed);
+                let mean = cell_irradiance(&lighting, &cells, &s, e, &mut hints);
+                assert_eq!(mean.x, mean.z);
+                sum += f64::from(mean.x);
+            }
+            let mean = sum / turns as f64;
+            assert!((mean - lit).abs() < 0.03, "d = {d}: {mean} vs {lit}");
+        }
+        for x in [-2.0 * rho, 2.0 * rho, 1.0] {
+            let s = sample(x, rho, 7);
+            let e = lighting.irradiance(s.position, s.normal, s.seed);
+            assert_eq!(cell_irradiance(&lighting, &cells, &s, e, &mut hints), e);
+        }
+    }
+
+    /// Soft lights are neither probed nor averaged: under an environment alone every sample
+    /// keeps its value; with the directional light added, a cell across the edge keeps the
+    /// environment's share and averages the directional light's.
+    #[test]
+    fn soft_lights_keep_their_share() {
+        let (mut lights, plate) = half_plane_shadow();
+        let sky = Light::Environment {
+            color: Vec3::splat(0.25),
+            intensity: 1.0,
+            map: None,
+            rotation_degrees: 0.0,
+            samples: 16,
+        };
+        let cells = CellAverage::new();
+        let rho = 0.05;
+        let mut hints = ShadowHints::default();
+        let only_sky = [sky.clone()];
+        let lighting = Lighting::new(&only_sky, Some(&plate), 10.0);
+        let s = sample(0.0, rho, 3);
+        let e = lighting.irradiance(s.position, s.normal, s.seed);
+        assert_eq!(cell_irradiance(&lighting, &cells, &s, e, &mut hints), e);
+
+        lights.push(sky);
+        let lighting = Lighting::new(&lights, Some(&plate), 10.0);
+        let s = sample(0.2 * rho, rho, 3);
+        let e = lighting.irradiance(s.position, s.normal, s.seed);
+        let sky_share = e - lighting.hard_only().irradiance(s.position, s.normal, s.seed);
+        let mean = cell_irradiance(&lighting, &cells, &s, e, &mut hints);
+        let directional = mean - sky_share;
+        assert!(
+            directional.x > 0.3 && directional.x < 1.0,
+            "{mean} = {sky_share} + {directional}"
+        );
+    }
+
+    /// Only edge-refined averages cells; every other method keeps JB02's irradiance at the
+    /// sample.
+    #[test]
+    fn only_edge_refined_averages() {
+        for method in Method::ALL {
+            assert_eq!(method.averages_edge_cells(), method == Method::EdgeRefined);
+        }
+    }
 }

@@ -223,7 +223,7 @@ pub fn bake_planned(
         b.finish_and_clear();
         let total: usize = sets.iter().map(|s| s.len()).sum();
         let b = bar(progress, total as u64, "irradiance");
-        irradiance::light_samples(&prep, &mut sets, &lighting, &b);
+        irradiance::light_samples(&prep, &mut sets, &lighting, scene.render.method, &b);
         b.finish_and_clear();
         Ok((sets, plan))
     })
@@ -281,7 +281,7 @@ fn render_in_pool(
             let t = Instant::now();
             let total: usize = sets.iter().map(|s| s.len()).sum();
             let b = bar(options.progress, total as u64, "irradiance");
-            irradiance::light_samples(&prep, &mut sets, &lighting, &b);
+            irradiance::light_samples(&prep, &mut sets, &lighting, scene.render.method, &b);
             b.finish_and_clear();
             timings.irradiance = t.elapsed();
             Cow::Owned(sets)
