@@ -346,7 +346,7 @@ pub struct ExhaustiveRow {
     pub evaluations_per_lookup: f64,
 }
 
-/// Local-global and edge-aware at one smoothing factor, at the sheet count (claim 2).
+/// The split methods at one smoothing factor, at the sheet count (claim 2).
 #[derive(Clone, Debug)]
 pub struct SmoothingRow {
     /// The scene.
@@ -357,10 +357,12 @@ pub struct SmoothingRow {
     pub local_global: RunResult,
     /// Edge-aware's run.
     pub edge_aware: RunResult,
+    /// Edge-refined's run.
+    pub edge_refined: RunResult,
 }
 
-/// Local-global's and edge-aware's errors at the sheet count split into the global and the
-/// local term (see the `split` module), per region.
+/// The split methods' errors at the sheet count split into the global and the local term (see
+/// the `split` module), per region.
 #[derive(Clone, Debug)]
 pub struct ErrorSplit {
     /// The scene.
@@ -369,10 +371,10 @@ pub struct ErrorSplit {
     pub samples: usize,
     /// The smoothing factor the truth was re-rendered with to match their α.
     pub truth_smoothing: f32,
-    /// Shadow-edge band: local-global, edge-aware.
-    pub band: [TermErrors; 2],
-    /// Translucent pixels: local-global, edge-aware.
-    pub translucent: [TermErrors; 2],
+    /// Shadow-edge band: local-global, edge-aware, edge-refined.
+    pub band: [TermErrors; 3],
+    /// Translucent pixels: local-global, edge-aware, edge-refined.
+    pub translucent: [TermErrors; 3],
 }
 
 /// The K table against exact K per pixel (textured scene, edge-aware).
@@ -529,8 +531,8 @@ fn run_scene(
             ));
             report.threads = result.threads;
             if count == config.sheet_count {
-                // The error split compares LM07 and N10 (edge-refined is in its own table).
-                if matches!(setting.method, Method::LocalGlobal | Method::EdgeAware) {
+                // The error split compares the split methods.
+                if setting.method.is_split() {
                     split_runs.push((first.stats.samples, first.pixels));
                 }
                 sheet_images.push((setting, first.image));
@@ -559,7 +561,7 @@ fn run_scene(
     }
     let sweep = smoothing_sweep(config, scene, &base, report, &reference, log)?;
     report.smoothing.extend(sweep);
-    if let [(samples, lm), (_, n10)] = &split_runs[..] {
+    if let [(samples, lm), (_, n10), (_, refined)] = &split_runs[..] {
         let mut matched = truth_run.clone();
         matched.render.smoothing =
             split::matched_smoothing(base.render.smoothing, reference.samples, *samples);
@@ -570,7 +572,8 @@ fn run_scene(
         let exact = runner::render_once(&matched, false, Some(&truth_samples))?;
         let exact_global: Vec<glam::Vec3> = exact.pixels.iter().map(|p| p.global).collect();
         let errors = |mask: &[bool]| {
-            [lm, n10].map(|run| split::term_errors(&reference.exitance, &exact_global, run, mask))
+            [lm, n10, refined]
+                .map(|run| split::term_errors(&reference.exitance, &exact_global, run, mask))
         };
         report.splits.push(ErrorSplit {
             scene,
@@ -611,8 +614,8 @@ fn run_scene(
     Ok(())
 }
 
-/// Local-global and edge-aware at the sheet count for every smoothing factor of the config
-/// (claim 2). At the scene's own k the main runs are reused.
+/// The split methods at the sheet count for every smoothing factor of the config (claim 2). At
+/// the scene's own k the main runs are reused.
 ///
 /// Why a sweep: at k = 1.5 the two differ little in the shadow-edge band, because most of the
 /// band's error there is the global sum's, which both share (the `split` step: on the
@@ -633,15 +636,20 @@ fn smoothing_sweep(
         method,
         epsilon: config.split_epsilon,
     };
-    let (lm, n10) = (setting(Method::LocalGlobal), setting(Method::EdgeAware));
+    let (lm, n10, refined) = (
+        setting(Method::LocalGlobal),
+        setting(Method::EdgeAware),
+        setting(Method::EdgeRefined),
+    );
     let mut rows = Vec::new();
     for &k in &config.smoothings {
-        let (local_global, edge_aware) = if k == base.render.smoothing {
+        let (local_global, edge_aware, edge_refined) = if k == base.render.smoothing {
             match (
                 report::find(report, scene, lm, n),
                 report::find(report, scene, n10, n),
+                report::find(report, scene, refined, n),
             ) {
-                (Some(l), Some(e)) => (l.clone(), e.clone()),
+                (Some(l), Some(e), Some(r)) => (l.clone(), e.clone(), r.clone()),
                 _ => {
                     return Err(BenchError::new(
                         "internal: the split runs at the sheet count are missing",
@@ -654,15 +662,18 @@ fn smoothing_sweep(
             let run = |s| -> Result<RunResult, BenchError> {
                 Ok(runner::run_config(&with_k, scene, s, n, &config.seeds, reference)?.0)
             };
-            (run(lm)?, run(n10)?)
+            (run(lm)?, run(n10)?, run(refined)?)
         };
         log(&format!(
-            "{}: {n} samples, k = {k}: edge band local-global {:.3e}, edge-aware {:.3e}",
+            "{}: {n} samples, k = {k}: edge band local-global {:.3e}, edge-aware {:.3e}, edge-refined {:.3e}",
             scene.name(),
             local_global
                 .edge_error
                 .map_or(f64::NAN, |e| e.mean_relative_l1),
             edge_aware
+                .edge_error
+                .map_or(f64::NAN, |e| e.mean_relative_l1),
+            edge_refined
                 .edge_error
                 .map_or(f64::NAN, |e| e.mean_relative_l1),
         ));
@@ -671,6 +682,7 @@ fn smoothing_sweep(
             smoothing: k,
             local_global,
             edge_aware,
+            edge_refined,
         });
     }
     Ok(rows)

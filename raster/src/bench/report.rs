@@ -48,33 +48,37 @@ fn split(report: &BenchReport, method: Method) -> MethodSetting {
     }
 }
 
-/// Claim 2 at every smoothing factor k of the sweep: the band errors, their ratio, the overall
-/// errors and edge-aware's seed noise, then each method at the k that suits it best.
+/// Claim 2 at every smoothing factor k of the sweep: the band errors, their ratios, the overall
+/// errors and the seed noise, then each method at the k that suits it best.
 fn smoothing_sweep(report: &BenchReport, s: &mut String) {
     if report.smoothing.is_empty() {
         return;
     }
     let _ = writeln!(
         s,
-        "\nThe same at {} samples for several smoothing radii α = k·√Ā (`docs/physics.md` §12: k ≈ 1–3; every other run uses the scene's k, 1.5). A larger α hands more of the sum to the noise-free local term: local-global's edge hardens, edge-aware's does not.\n\n| scene | k | edge band: local-global | edge-aware | ratio | overall: local-global | edge-aware | noise: local-global | edge-aware |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "\nThe same at {} samples for several smoothing radii α = k·√Ā (`docs/physics.md` §12: k ≈ 1–3; every other run uses the scene's k, 1.5). A larger α hands more of the sum to the noise-free local term: local-global's edge hardens, edge-aware's does not; edge-refined's local term follows the light, but its 12 nodes resolve a larger disc more coarsely. Ratios are to local-global at the same k.\n\n| scene | k | edge band: local-global | edge-aware | edge-refined | ratio: edge-aware | edge-refined | overall: local-global | edge-aware | edge-refined | noise: local-global | edge-aware | edge-refined |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
         report.config.sheet_count
     );
     let band = |r: &RunResult| r.edge_error.map_or(f64::NAN, |e| e.mean_relative_l1);
     let noise = |r: &RunResult| r.noise.map_or(f64::NAN, |n| n.mean_relative);
     for row in &report.smoothing {
-        let (l, e) = (&row.local_global, &row.edge_aware);
+        let (l, e, r) = (&row.local_global, &row.edge_aware, &row.edge_refined);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.2} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {:.2} | {:.2} | {} | {} | {} | {} | {} | {} |",
             row.scene.name(),
             row.smoothing,
             pct(band(l)),
             pct(band(e)),
+            pct(band(r)),
             band(e) / band(l),
+            band(r) / band(l),
             pct(l.error.mean_relative_l1),
             pct(e.error.mean_relative_l1),
+            pct(r.error.mean_relative_l1),
             pct(noise(l)),
             pct(noise(e)),
+            pct(noise(r)),
         );
     }
     let _ = writeln!(s);
@@ -89,26 +93,34 @@ fn smoothing_sweep(report: &BenchReport, s: &mut String) {
                 .map(|r| (r.smoothing, band(f(r))))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
         };
-        let met: Vec<String> = rows
-            .iter()
-            .filter(|r| band(&r.edge_aware) <= 0.5 * band(&r.local_global))
-            .map(|r| r.smoothing.to_string())
-            .collect();
-        if let (Some((kl, bl)), Some((ke, be))) =
-            (best(|r| &r.local_global), best(|r| &r.edge_aware))
-        {
+        let met = |f: fn(&SmoothingRow) -> &RunResult| {
+            let ks: Vec<String> = rows
+                .iter()
+                .filter(|r| band(f(r)) <= 0.5 * band(&r.local_global))
+                .map(|r| r.smoothing.to_string())
+                .collect();
+            if ks.is_empty() {
+                "at none".to_string()
+            } else {
+                format!("met at k = {}", ks.join(", "))
+            }
+        };
+        if let (Some((kl, bl)), Some((ke, be)), Some((kr, br))) = (
+            best(|r| &r.local_global),
+            best(|r| &r.edge_aware),
+            best(|r| &r.edge_refined),
+        ) {
             let _ = writeln!(
                 s,
-                "- {}: band ratio ≤ 0.5 at the same k: {}. Each at its best k: local-global {} (k = {kl}), edge-aware {} (k = {ke}), ratio {:.2}.",
+                "- {}: band ratio ≤ 0.5 at the same k: edge-aware {}, edge-refined {}. Each at its best k: local-global {} (k = {kl}), edge-aware {} (k = {ke}, ratio {:.2}), edge-refined {} (k = {kr}, ratio {:.2}).",
                 scene.name(),
-                if met.is_empty() {
-                    "at none".to_string()
-                } else {
-                    format!("met at k = {}", met.join(", "))
-                },
+                met(|r| &r.edge_aware),
+                met(|r| &r.edge_refined),
                 pct(bl),
                 pct(be),
-                be / bl
+                be / bl,
+                pct(br),
+                br / bl
             );
         }
     }
@@ -121,25 +133,29 @@ fn error_split(report: &BenchReport, s: &mut String) {
     }
     let _ = writeln!(
         s,
-        "\nWhere the error comes from, at the scene's k: each split run's error against the truth divided into its global and its local term, the truth split at the runs' own α (re-rendered at the matched k; `raster/src/bench/split.rs`). Shares of the truth's exitance, Σ|error| / Σ|truth| (not the offset-relative error above).\n\n| scene | samples | region | global term: local-global | edge-aware | local term: local-global | edge-aware | local ratio | total: local-global | edge-aware |\n|---|---:|---|---:|---:|---:|---:|---:|---:|---:|"
+        "\nWhere the error comes from, at the scene's k: each split run's error against the truth divided into its global and its local term, the truth split at the runs' own α (re-rendered at the matched k; `raster/src/bench/split.rs`). Shares of the truth's exitance, Σ|error| / Σ|truth| (not the offset-relative error above).\n\n| scene | samples | region | global term: local-global | edge-aware | edge-refined | local term: local-global | edge-aware | edge-refined | local ratio: edge-aware | edge-refined | total: local-global | edge-aware | edge-refined |\n|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for split in &report.splits {
-        for (region, [l, e]) in [
+        for (region, [l, e, r]) in [
             ("edge band", split.band),
             ("translucent", split.translucent),
         ] {
             let _ = writeln!(
                 s,
-                "| {} | {} | {region} | {} | {} | {} | {} | {:.2} | {} | {} |",
+                "| {} | {} | {region} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {} | {} | {} |",
                 split.scene.name(),
                 split.samples,
                 pct(l.global),
                 pct(e.global),
+                pct(r.global),
                 pct(l.local),
                 pct(e.local),
+                pct(r.local),
                 e.local / l.local,
+                r.local / l.local,
                 pct(l.total),
                 pct(e.total),
+                pct(r.total),
             );
         }
     }
@@ -556,7 +572,7 @@ pub fn write_csv(report: &BenchReport, path: &Path) -> Result<(), BenchError> {
     let opt = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
     // The sweep's rows at the scene's own k are main runs already.
     let sweep = report.smoothing.iter().flat_map(|row| {
-        [&row.local_global, &row.edge_aware]
+        [&row.local_global, &row.edge_aware, &row.edge_refined]
             .into_iter()
             .filter(|r| {
                 !report

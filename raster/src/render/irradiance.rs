@@ -377,7 +377,9 @@ mod tests {
         let lighting = Lighting::new(&lights, Some(&plate), 10.0);
         let s = sample(0.2 * rho, rho, 3);
         let e = lighting.irradiance(s.position, s.normal, s.seed);
-        let sky_share = e - lighting.hard_only().irradiance(s.position, s.normal, s.seed);
+        let sky_share = e - lighting
+            .hard_only()
+            .irradiance(s.position, s.normal, s.seed);
         let mean = cell_irradiance(&lighting, &cells, &s, e, &mut hints);
         let directional = mean - sky_share;
         assert!(

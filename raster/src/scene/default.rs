@@ -82,7 +82,7 @@ mod tests {
     fn default_scene_loads_with_its_settings() {
         let s = default_scene();
         assert_eq!((s.camera.width, s.camera.height), (512, 512));
-        assert_eq!(s.render.method, Method::EdgeAware);
+        assert_eq!(s.render.method, Method::EdgeRefined);
         assert_eq!(
             s.output.png.as_deref(),
             Some(std::path::Path::new("lucent.png"))

@@ -312,7 +312,7 @@ pub struct RenderSettings {
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
-            method: Method::EdgeAware,
+            method: Method::EdgeRefined,
             samples: SampleRequest::Auto,
             max_samples: None,
             epsilon: 0.5,
