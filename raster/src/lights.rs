@@ -448,17 +448,24 @@ fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// Two triangles covering the rectangle [x0, x1] × [−half, half] at height h, facing ±z: an
+/// occluder for the tests of shadows (a plate far wider than the lit area is a half-plane).
+#[cfg(test)]
+pub(crate) fn test_plate(x0: f32, x1: f32, half: f32, h: f32) -> [[Vec3; 3]; 2] {
+    let corner = |x: f32, y: f32| Vec3::new(x, y, h);
+    [
+        [corner(x0, -half), corner(x1, -half), corner(x1, half)],
+        [corner(x0, -half), corner(x1, half), corner(x0, half)],
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// A plate over x ∈ [x0, x1], y ∈ [−5, 5] at height h (two triangles).
     fn plate(x0: f32, x1: f32, h: f32) -> [[Vec3; 3]; 2] {
-        let corner = |x: f32, y: f32| Vec3::new(x, y, h);
-        [
-            [corner(x0, -5.0), corner(x1, -5.0), corner(x1, 5.0)],
-            [corner(x0, -5.0), corner(x1, 5.0), corner(x0, 5.0)],
-        ]
+        test_plate(x0, x1, 5.0, h)
     }
 
     fn point_light(position: Vec3, intensity: f32) -> Light {

@@ -275,18 +275,7 @@ mod tests {
         let lights = [light(&frame, 16.0, 256)];
         // A half-plane x < 0 at height 2: under its edge, half of the light is hidden.
         let h = 2.0;
-        let bvh = Bvh::build(&[
-            [
-                Vec3::new(-100.0, -100.0, h),
-                Vec3::new(0.0, -100.0, h),
-                Vec3::new(0.0, 100.0, h),
-            ],
-            [
-                Vec3::new(-100.0, -100.0, h),
-                Vec3::new(0.0, 100.0, h),
-                Vec3::new(-100.0, 100.0, h),
-            ],
-        ]);
+        let bvh = Bvh::build(&crate::lights::test_plate(-100.0, 0.0, 100.0, h));
         let l = Lighting::new(&lights, Some(&bvh), 10.0);
         let open = Lighting::new(&lights, None, 10.0);
         let frac = |x: f32| {

@@ -301,11 +301,7 @@ mod tests {
             color: Vec3::ONE,
             irradiance: 1.0,
         }];
-        let at = |x: f32, y: f32| Vec3::new(x, y, 1.0);
-        let plate = Bvh::build(&[
-            [at(-5.0, -5.0), at(0.0, -5.0), at(0.0, 5.0)],
-            [at(-5.0, -5.0), at(0.0, 5.0), at(-5.0, 5.0)],
-        ]);
+        let plate = Bvh::build(&crate::lights::test_plate(-5.0, 0.0, 5.0, 1.0));
         (lights, plate)
     }
 
