@@ -10,7 +10,7 @@ use super::BenchArgs;
 use super::{BakeArgs, RenderArgs, SamplesArg};
 #[cfg(feature = "harness")]
 use crate::bench::{self, BenchConfig, BenchScene};
-use crate::output::{refuse_read_only, write_exr, write_png};
+use crate::output::{Placement, Region, refuse_read_only, write_exr, write_exr_tile, write_png};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
     MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene, default_scene,
@@ -179,7 +179,7 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
 /// atomic on its own, but a render writes the PNG and then the EXR: without this check, an EXR
 /// path in a missing directory failed only after the PNG had been replaced (exit 1 with a
 /// changed file), and the whole render was wasted.
-fn check_outputs(paths: &[&Path]) -> Result<(), String> {
+pub(super) fn check_outputs(paths: &[&Path]) -> Result<(), String> {
     for (i, path) in paths.iter().enumerate() {
         let shown = path.display();
         if path.file_name().is_none() {
@@ -206,6 +206,26 @@ fn check_outputs(paths: &[&Path]) -> Result<(), String> {
     Ok(())
 }
 
+/// Checks `--crop` against the image size (after --width and --height) and the outputs: a
+/// tile's files are named on the command line, never the scene's (those are the whole image's).
+fn check_crop(crop: &Region, args: &RenderArgs, scene: &Scene) -> Result<(), String> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    crop.check_within(w, h).map_err(|e| {
+        let from = match (args.width, args.height) {
+            (None, None) => "the scene's size",
+            _ => "the size after --width/--height",
+        };
+        format!("--crop {crop}: {e} ({from})")
+    })?;
+    if args.output.is_none() && args.exr.is_none() {
+        return Err(format!(
+            "--crop {crop}: name the tile's file with --exr OUT.exr (for `lucent merge`) or -o \
+             OUT.png; the scene's [output] files are the whole image's"
+        ));
+    }
+    Ok(())
+}
+
 fn seconds(d: std::time::Duration) -> String {
     format!("{:.2} s", d.as_secs_f64())
 }
@@ -215,6 +235,9 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
     let mut scene = load(args.scene.as_deref())?;
     apply(args, &mut scene)?;
+    if let Some(crop) = &args.crop {
+        check_crop(crop, args, &scene)?;
+    }
     let outputs: Vec<&Path> = [&scene.output.png, &scene.output.exr]
         .into_iter()
         .flatten()
@@ -232,6 +255,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         baked: baked.as_deref(),
         progress: !args.quiet,
         warn: true,
+        crop: args.crop,
         ..RenderOptions::default()
     };
     let result = render::render(&scene, &options).map_err(|e| e.to_string())?;
@@ -242,20 +266,30 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         written.push(png.display().to_string());
     }
     if let Some(exr) = &scene.output.exr {
-        write_exr(
-            exr,
-            &result.image,
-            Some(&result.alpha()),
-            &result.layers(&scene.output.layers),
-        )
+        let (alpha, layers) = (result.alpha(), result.layers(&scene.output.layers));
+        match args.crop {
+            None => write_exr(exr, &result.image, Some(&alpha), &layers),
+            Some(region) => {
+                let placement = Placement {
+                    display: (scene.camera.width, scene.camera.height),
+                    region,
+                    exposure: scene.render.exposure,
+                };
+                write_exr_tile(exr, &placement, &result.image, Some(&alpha), &layers)
+            }
+        }
         .map_err(|e| e.to_string())?;
         written.push(exr.display().to_string());
     }
     if !args.quiet {
         let s = &result.stats;
         let t = &s.timings;
+        let region = &result.region;
+        let crop = args.crop.map_or(String::new(), |r| {
+            format!(", crop {r} ({}×{})", r.width(), r.height())
+        });
         outln!(
-            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
+            "lucent: {}×{}{crop}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
@@ -269,8 +303,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             seconds(t.raster),
             seconds(t.shading),
             s.queries,
-            s.shading_points as f64
-                / (f64::from(scene.camera.width) * f64::from(scene.camera.height)),
+            s.shading_points as f64 / region.pixels() as f64,
             seconds(t.refine),
             s.probed_pixels,
             s.refined_pixels,

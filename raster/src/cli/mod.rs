@@ -1,4 +1,4 @@
-//! The `lucent` command line: `render` (the default), `bake`, `presets`, and with the feature
+//! The `lucent` command line: `render` (the default), `bake`, `merge`, `presets`, and with the feature
 //! `harness` (on by default) `compare` and `bench`.
 //!
 //! Exit codes: 0 success, 1 a runtime error (bad scene, missing file, …; the message names the
@@ -17,12 +17,15 @@ macro_rules! outln {
 mod commands;
 #[cfg(feature = "harness")]
 mod compare;
+mod merge;
 
 use std::path::PathBuf;
 
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand};
 use lucent_core::Method;
+
+use crate::output::Region;
 
 /// Writes one line to standard output (see [`outln`]).
 fn write_line(line: std::fmt::Arguments) -> Result<(), String> {
@@ -64,6 +67,9 @@ pub enum Command {
     /// Place and light a scene's irradiance samples and write them to a PLY point cloud, for
     /// `render --samples-from`.
     Bake(BakeArgs),
+    /// Assemble tiles rendered with `render --crop … --exr` into the whole image (PNG and/or
+    /// OpenEXR), the same bytes a single render writes.
+    Merge(MergeArgs),
     /// List the measured materials (Jensen et al. 2001) usable as `preset = "…"`.
     Presets,
     /// Run time against error: render the benchmark scenes at several sample counts with
@@ -133,7 +139,38 @@ pub struct RenderArgs {
     /// Load irradiance samples baked by `lucent bake` instead of placing and lighting new ones.
     #[arg(long, value_name = "FILE.ply")]
     pub samples_from: Option<PathBuf>,
+    /// Render only the pixels x0..x1 × y0..y1 (x1, y1 exclusive) of the image, a tile for
+    /// `lucent merge`: each is bit for bit the pixel of a whole render. --exr writes the tile
+    /// with its place in the image; -o writes the tile alone as a PNG. Outputs must be named on
+    /// the command line. Use the same samples for every tile (--samples-from).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
+    pub crop: Option<Region>,
     /// Print nothing but errors and warnings.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_crop(text: &str) -> Result<Region, String> {
+    Region::parse(text)
+}
+
+/// Options of `merge`.
+#[derive(Debug, Args, Clone)]
+pub struct MergeArgs {
+    /// The tiles (OpenEXR files written by `render --crop … --exr`), in any order; together
+    /// they must cover the image exactly once.
+    #[arg(required = true, value_name = "TILE.exr")]
+    pub tiles: Vec<PathBuf>,
+    /// Write the merged image as a PNG (8-bit sRGB at the tiles' exposure).
+    #[arg(short, long, value_name = "OUT.png")]
+    pub output: Option<PathBuf>,
+    /// Write the merged image as an OpenEXR (beauty, alpha and every layer of the tiles).
+    #[arg(long, value_name = "OUT.exr")]
+    pub exr: Option<PathBuf>,
+    /// The PNG's exposure in stops, instead of the one recorded in the tiles.
+    #[arg(long, value_name = "STOPS", allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+    /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -264,6 +301,7 @@ pub fn main() -> i32 {
         None => commands::render(&cli.render),
         Some(Command::Render(args)) => commands::render(&args),
         Some(Command::Bake(args)) => commands::bake(&args),
+        Some(Command::Merge(args)) => merge::merge(&args),
         Some(Command::Presets) => commands::presets(),
         #[cfg(feature = "harness")]
         Some(Command::Compare(args)) => compare::compare(&args),

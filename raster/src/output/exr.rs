@@ -40,13 +40,15 @@ use std::io::{BufReader, Seek, SeekFrom};
 use std::path::Path;
 
 use exr::prelude::{
-    AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, LayerAttributes,
-    LineOrder, MetaData, ReadChannels, ReadLayers, SmallVec, Text, Vec2, WritableImage,
+    AnyChannel, AnyChannels, AttributeValue, Blocks, Compression, Encoding, FlatSamples, Image,
+    ImageAttributes, IntegerBounds, LayerAttributes, LineOrder, MetaData, ReadChannels, ReadLayers,
+    SmallVec, Text, Vec2, WritableImage,
 };
 use glam::Vec3;
 
 use super::atomic::write_atomically;
 use super::image::{MAX_PIXELS, is_valid_name};
+use super::tile::{EXPOSURE_ATTRIBUTE, Placement};
 use super::{Layer, LayerData, OutputError, RgbImage};
 
 /// The most channels a part may have for lucent to read it.
@@ -74,7 +76,34 @@ pub fn write_exr(
     alpha: Option<&[f32]>,
     layers: &[Layer],
 ) -> Result<(), OutputError> {
+    write_exr_placed(path, beauty, alpha, layers, None)
+}
+
+/// [`write_exr`], or with a `placement` a tile ([`super::tile`]): `beauty`, `alpha` and
+/// `layers` are the region's pixels, written as the data window of the full image's display
+/// window, with the exposure in the header.
+pub(super) fn write_exr_placed(
+    path: &Path,
+    beauty: &RgbImage,
+    alpha: Option<&[f32]>,
+    layers: &[Layer],
+    placement: Option<&Placement>,
+) -> Result<(), OutputError> {
     let (width, height) = beauty.size();
+    if let Some(placement) = placement {
+        placement.check(path)?;
+        let region = placement.region;
+        if (region.width(), region.height()) != (width, height) {
+            return Err(OutputError::invalid(
+                path,
+                format!(
+                    "the region {region} is {}x{}, the image {width}x{height}",
+                    region.width(),
+                    region.height()
+                ),
+            ));
+        }
+    }
     if width == 0 || height == 0 {
         return Err(OutputError::invalid(
             path,
@@ -150,10 +179,18 @@ pub fn write_exr(
         }
     }
 
-    let attributes = LayerAttributes {
+    let mut attributes = LayerAttributes {
         software_name: Some(text(path, "lucent")?),
         ..Default::default()
     };
+    if let Some(placement) = placement {
+        let region = placement.region;
+        attributes.layer_position = Vec2(region.x0 as i32, region.y0 as i32);
+        attributes.other.insert(
+            text(path, EXPOSURE_ATTRIBUTE)?,
+            AttributeValue::F32(placement.exposure),
+        );
+    }
     let encoding = Encoding {
         compression: Compression::ZIP16,
         blocks: Blocks::ScanLines,
@@ -165,7 +202,14 @@ pub fn write_exr(
         encoding,
         AnyChannels::sort(list),
     );
-    let image = Image::from_layer(layer);
+    let image = match placement {
+        None => Image::from_layer(layer),
+        Some(placement) => {
+            let (w, h) = placement.display;
+            let display = IntegerBounds::new(Vec2(0, 0), Vec2(w as usize, h as usize));
+            Image::new(ImageAttributes::new(display), layer)
+        }
+    };
     write_atomically(path, |w| {
         // `non_parallel`: exr is built without rayon, and sequential block order keeps the
         // bytes independent of scheduling anyway.
@@ -211,12 +255,26 @@ fn push_rgb(
 /// One decoded channel with its full (`layer.channel`) name.
 struct Channel {
     name: String,
+    /// Position of its part's data window.
+    origin: (i32, i32),
     size: (u32, u32),
     values: Vec<f32>,
 }
 
+/// Where a decoded file's pixels lie (see [`read_exr_framed`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Frame {
+    /// The display window's position and size.
+    pub display_origin: (i32, i32),
+    pub display_size: (u64, u64),
+    /// The data window's position (of the part holding `R`, `G`, `B`).
+    pub data_origin: (i32, i32),
+    /// The float attribute [`EXPOSURE_ATTRIBUTE`], if present.
+    pub exposure: Option<f32>,
+}
+
 /// Decodes every channel of every part, largest resolution level only.
-fn load_channels(path: &Path) -> Result<Vec<Channel>, OutputError> {
+fn load_channels(path: &Path) -> Result<(Vec<Channel>, Frame), OutputError> {
     let exr_err = |source: exr::error::Error| OutputError::Exr {
         path: path.to_path_buf(),
         source,
@@ -258,9 +316,22 @@ fn load_channels(path: &Path) -> Result<Vec<Channel>, OutputError> {
         .from_buffered(reader)
         .map_err(exr_err)?;
 
+    let display = image.attributes.display_window;
+    let exposure_name = text(path, EXPOSURE_ATTRIBUTE)?;
+    let mut exposure = match image.attributes.other.get(&exposure_name) {
+        Some(AttributeValue::F32(x)) => Some(*x),
+        _ => None,
+    };
     let mut channels = Vec::new();
     for part in image.layer_data {
+        if let Some(AttributeValue::F32(x)) = part.attributes.other.get(&exposure_name) {
+            exposure = exposure.or(Some(*x));
+        }
         let size = (part.size.0 as u32, part.size.1 as u32);
+        let origin = (
+            part.attributes.layer_position.0,
+            part.attributes.layer_position.1,
+        );
         let prefix = part.attributes.layer_name.as_ref().map(|t| t.to_string());
         for ch in part.channel_data.list {
             let short = ch.name.to_string();
@@ -273,10 +344,25 @@ fn load_channels(path: &Path) -> Result<Vec<Channel>, OutputError> {
                 // Subsampled channels (e.g. chroma) are not images of the full size.
                 continue;
             }
-            channels.push(Channel { name, size, values });
+            channels.push(Channel {
+                name,
+                origin,
+                size,
+                values,
+            });
         }
     }
-    Ok(channels)
+    let data_origin = channels
+        .iter()
+        .find(|c| c.name == "R")
+        .map_or((0, 0), |c| c.origin);
+    let frame = Frame {
+        display_origin: (display.position.0, display.position.1),
+        display_size: (display.size.0 as u64, display.size.1 as u64),
+        data_origin,
+        exposure,
+    };
+    Ok((channels, frame))
 }
 
 /// Finds `prefix.R/G/B` and interleaves them; `None` if one is missing.
@@ -290,7 +376,7 @@ fn take_rgb(channels: &[Channel], prefix: &str) -> Option<((u32, u32), Vec<Vec3>
         channels.iter().find(|c| c.name == full)
     };
     let (r, g, b) = (find("R")?, find("G")?, find("B")?);
-    if r.size != g.size || r.size != b.size {
+    if r.size != g.size || r.size != b.size || r.origin != g.origin || r.origin != b.origin {
         return None;
     }
     let pixels = r
@@ -333,15 +419,30 @@ fn beauty(path: &Path, channels: &[Channel]) -> Result<RgbImage, OutputError> {
 
 /// Reads the beauty channels `R`, `G`, `B` of an OpenEXR file as linear RGB.
 pub fn read_exr_rgb(path: &Path) -> Result<RgbImage, OutputError> {
-    let channels = load_channels(path)?;
+    let (channels, _) = load_channels(path)?;
     beauty(path, &channels)
 }
 
 /// Reads the beauty image and every recognised layer (see the module doc). Layers whose size
 /// differs from the beauty image's are an error.
 pub fn read_exr(path: &Path) -> Result<ExrImage, OutputError> {
-    let channels = load_channels(path)?;
+    read_exr_framed(path).map(|(image, _)| image)
+}
+
+/// [`read_exr`], also returning the display and data windows and the exposure attribute.
+/// Layers and alpha whose data window differs from the beauty image's are an error.
+pub(super) fn read_exr_framed(path: &Path) -> Result<(ExrImage, Frame), OutputError> {
+    let (channels, frame) = load_channels(path)?;
     let beauty = beauty(path, &channels)?;
+    let misplaced = |name: &str, origin: (i32, i32)| {
+        OutputError::invalid(
+            path,
+            format!(
+                "'{name}' starts at ({}, {}), the beauty image at ({}, {})",
+                origin.0, origin.1, frame.data_origin.0, frame.data_origin.1
+            ),
+        )
+    };
 
     let mut prefixes: Vec<&str> = Vec::new();
     for c in &channels {
@@ -368,6 +469,9 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, OutputError> {
         } else {
             continue;
         };
+        if let Some(c) = members.iter().find(|c| c.origin != frame.data_origin) {
+            return Err(misplaced(&c.name, c.origin));
+        }
         if size != beauty.size() {
             return Err(OutputError::SizeMismatch {
                 what: "EXR layer size vs. beauty size",
@@ -378,6 +482,7 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, OutputError> {
         layers.push(layer);
     }
     let alpha = match channels.iter().find(|c| c.name == "A") {
+        Some(a) if a.origin != frame.data_origin => return Err(misplaced("A", a.origin)),
         Some(a) if a.size == beauty.size() => Some(a.values.clone()),
         Some(a) => {
             return Err(OutputError::SizeMismatch {
@@ -388,11 +493,12 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, OutputError> {
         }
         None => None,
     };
-    Ok(ExrImage {
+    let image = ExrImage {
         beauty,
         alpha,
         layers,
-    })
+    };
+    Ok((image, frame))
 }
 
 #[cfg(test)]

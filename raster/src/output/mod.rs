@@ -7,6 +7,8 @@
 //! | [`srgb`] | the sRGB transfer function and the exact 8-bit encoder |
 //! | [`png`] | 8-bit sRGB PNG with exposure; PNG back to linear |
 //! | [`exr`] | float OpenEXR with layers; reading the beauty back |
+//! | [`tile`] | a [`Region`] of an image as an OpenEXR tile (data window in the display window) |
+//! | [`merge`] | assembling tiles into the whole image |
 //! | [`ply`] | the baked irradiance sample set (binary PLY) |
 //! | `compare` | RMSE, relative L1, maximum error between two images |
 //! | `heatmap` | per-pixel error as a colour-ramp PNG |
@@ -28,6 +30,7 @@ pub mod exr;
 #[cfg(feature = "harness")]
 pub mod heatmap;
 pub mod image;
+pub mod merge;
 #[cfg(feature = "harness")]
 pub mod noise;
 pub mod ply;
@@ -35,6 +38,7 @@ pub mod png;
 #[cfg(feature = "harness")]
 pub mod regions;
 pub mod srgb;
+pub mod tile;
 
 pub use atomic::{WriteSeek, refuse_read_only, write_atomically, write_text_atomically};
 #[cfg(feature = "harness")]
@@ -44,9 +48,11 @@ pub use exr::{ExrImage, read_exr, read_exr_rgb, write_exr};
 #[cfg(feature = "harness")]
 pub use heatmap::{ErrorMetric, Heatmap, HeatmapOptions, HeatmapScale, error_heatmap};
 pub use image::{Layer, LayerData, RgbImage};
+pub use merge::{Merged, merge_tiles};
 #[cfg(feature = "harness")]
 pub use noise::{NoiseStats, seed_noise};
 pub use ply::{SampleSet, read_ply, read_ply_with_comments, write_ply};
 pub use png::{read_png, write_png};
 #[cfg(feature = "harness")]
 pub use regions::{default_band_radius, shadow_edge_band, translucent_mask};
+pub use tile::{ExrTile, Placement, Region, read_exr_tile, write_exr_tile};

@@ -6,11 +6,14 @@
 //! another of its sub-samples, and the 3 × 3 block of representatives around it spans the
 //! pixel, so the edge also separates the pixel's representative from a neighbour's: the two
 //! first-pass values differ. Only pixels whose first-pass radiance differs from a neighbour's
-//! by more than [`CONTRAST`] (relative, with a floor at a tenth of the image's mean) are probed; elsewhere the first pass stands, bit for bit. An edge
-//! of lower contrast is not refined (its stair-steps are at most that contrast).
+//! by more than [`CONTRAST`] (relative, with a floor at [`FLOOR`] of the radiance the PNG shows
+//! as white) are probed; elsewhere the first pass stands, bit for bit. An edge of lower
+//! contrast is not refined (its stair-steps are at most that contrast).
 //!
-//! Every pixel's second-pass value depends only on the first-pass values (read-only) and its
-//! own sub-samples, so the image is the same for any thread count.
+//! Every pixel's second-pass value depends only on its own and its eight neighbours'
+//! first-pass values (read-only), its own sub-samples and the scene, so the image is the same
+//! for any thread count, and a tile of the image (`RenderOptions::crop`) whose first pass
+//! covers a one-pixel margin around it is the same as that part of the whole image.
 
 use glam::Vec3;
 use lucent_core::stats::NoStats;
@@ -18,17 +21,20 @@ use rayon::prelude::*;
 
 use super::RenderError;
 use super::shading::{PixelScratch, PixelValue, Shading, ShadingCounters};
+use crate::output::Region;
 
 /// A pixel is probed when, in some channel, its first-pass radiance `a` and a neighbour's `b`
-/// have `|a − b| / (a + b + FLOOR · mean)` above this (a ratio above 1.22 where the pixels are
-/// bright), `mean` being the image's mean radiance in that channel.
+/// have `|a − b| / (a + b + FLOOR · white)` above this (a ratio above 1.22 where the pixels are
+/// bright), `white` being the radiance the PNG shows as white, `2^−exposure`.
 pub const CONTRAST: f32 = 0.1;
 
-/// The floor in [`CONTRAST`]'s denominator, in units of the image's mean radiance: steps
-/// between pixels far darker than the mean are not probed unless they are large against the
-/// mean (on the shipped scenes it probes 20–75% fewer pixels than no floor, and refines 1–10%
-/// fewer).
-pub const FLOOR: f32 = 0.1;
+/// The floor in [`CONTRAST`]'s denominator, in units of the radiance the PNG shows as white:
+/// steps between dark pixels are not probed unless they are large against that. It is a
+/// property of the scene (its exposure), not of the pixels, so that a tile of the image knows
+/// it: a floor at a tenth of the image's mean radiance, which it replaces, needed the whole
+/// first pass. The shipped scenes' mean radiance is 0.04–0.18 of white (0.56 in the blue of
+/// the environment map), so this is about the floor of that rule.
+pub const FLOOR: f32 = 0.01;
 
 /// What the second pass did, summed over the image.
 #[derive(Clone, Copy, Debug, Default)]
@@ -56,7 +62,7 @@ fn contrast(a: Vec3, b: Vec3, floor: Vec3) -> f32 {
 }
 
 /// True if pixel `(x, y)` of the `width × height` radiance `colors` differs from one of its
-/// eight neighbours by more than [`CONTRAST`].
+/// eight neighbours (those inside `colors`) by more than [`CONTRAST`].
 fn near_a_change(
     colors: &[Vec3],
     floor: Vec3,
@@ -72,38 +78,43 @@ fn near_a_change(
     })
 }
 
-/// Re-shades, in place, the pixels of `pixels` (the first pass, row-major) that need more than
-/// one point per object; `collect_stats` as for the first pass.
+/// Re-shades, in place, the pixels of `region` that need more than one point per object.
+/// `pixels` is the first pass over `shaded` (row-major), which must hold `region` and, of its
+/// pixels' neighbours, those inside the image; `collect_stats` as for the first pass.
 pub(super) fn refine(
     shading: &Shading<'_>,
     pixels: &mut [PixelValue],
+    shaded: Region,
+    region: Region,
     collect_stats: bool,
 ) -> Result<Refined, RenderError> {
-    let (w, h) = (
-        shading.camera.width as usize,
-        shading.camera.height as usize,
-    );
+    let (w, h) = (shaded.width() as usize, shaded.height() as usize);
     let colors: Vec<Vec3> = pixels.iter().map(|p| p.color).collect();
-    let mean = colors.iter().fold(Vec3::ZERO, |s, &c| s + c) / colors.len().max(1) as f32;
-    let floor = mean * FLOOR;
+    let white = (-f64::from(shading.prep.scene.render.exposure)).exp2() as f32;
+    let floor = Vec3::splat(FLOOR * white);
     let rows: Vec<Result<Refined, RenderError>> = pixels
         .par_chunks_mut(w.max(1))
-        .enumerate()
-        .map(|(y, out)| {
+        .zip(shaded.y0..shaded.y1)
+        .filter(|(_, y)| (region.y0..region.y1).contains(y))
+        .map(|(out, y)| {
             let mut scratch = PixelScratch::default();
             let mut row = Refined::default();
-            for (x, slot) in out.iter_mut().enumerate() {
-                if !near_a_change(&colors, floor, w, h, x, y) {
+            for (x, slot) in (shaded.x0..shaded.x1).zip(out.iter_mut()) {
+                if !region.contains(x, y) {
+                    continue;
+                }
+                let (local_x, local_y) = ((x - shaded.x0) as usize, (y - shaded.y0) as usize);
+                if !near_a_change(&colors, floor, w, h, local_x, local_y) {
                     continue;
                 }
                 row.flagged += 1;
-                if !shading.split_pixel(x as u32, y as u32, &mut scratch) {
+                if !shading.split_pixel(x, y, &mut scratch) {
                     continue;
                 }
                 *slot = if collect_stats {
-                    shading.shade(x as u32, y as u32, &mut scratch, &mut row.stats)?
+                    shading.shade(x, y, &mut scratch, &mut row.stats)?
                 } else {
-                    shading.shade(x as u32, y as u32, &mut scratch, &mut NoStats)?
+                    shading.shade(x, y, &mut scratch, &mut NoStats)?
                 };
                 let groups = &scratch.groups.groups;
                 row.reshaded += 1;
@@ -185,8 +196,8 @@ mod tests {
             (0..h).all(|y| (0..w).all(|x| !near_a_change(colors, floor, w, h, x, y)))
         };
         assert!(quiet(&soft, Vec3::ZERO));
-        // The step above, in a dark corner of an image whose mean is 10: under the floor.
+        // The step above, in a dark corner of an image shown at white = 100: under the floor.
         assert!(!quiet(&colors, Vec3::ZERO));
-        assert!(quiet(&colors, Vec3::splat(10.0 * FLOOR)));
+        assert!(quiet(&colors, Vec3::splat(100.0 * FLOOR)));
     }
 }

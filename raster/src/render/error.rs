@@ -27,6 +27,8 @@ pub enum RenderError {
     Baked(String),
     /// A scene exceeds an internal limit.
     Limit(String),
+    /// The region to render ([`super::RenderOptions::crop`]) does not fit the image.
+    Crop(String),
     /// The core rejected a query (a bug if it ever happens: inputs are validated).
     Query {
         /// The shading point.
@@ -53,6 +55,7 @@ impl fmt::Display for RenderError {
             RenderError::BakedFile(e) => write!(f, "baked samples: {e}"),
             RenderError::Baked(m) => write!(f, "baked samples: {m}"),
             RenderError::Limit(m) => write!(f, "{m}"),
+            RenderError::Crop(m) => write!(f, "crop: {m}"),
             RenderError::Query { position, source } => {
                 write!(f, "internal error: query at {position}: {source}")
             }
@@ -74,7 +77,10 @@ impl std::error::Error for RenderError {
             RenderError::Query { source, .. } => Some(source),
             RenderError::Cache(e) => Some(e),
             RenderError::Threads(e) => Some(e),
-            RenderError::Baked(_) | RenderError::Limit(_) | RenderError::Core(_) => None,
+            RenderError::Baked(_)
+            | RenderError::Limit(_)
+            | RenderError::Crop(_)
+            | RenderError::Core(_) => None,
         }
     }
 }

@@ -47,7 +47,7 @@ pub use shading::{ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounter
 use crate::lights::Lighting;
 use crate::material::{MaterialError, Shader};
 use crate::output::image::{LAYER_EXITANCE, LAYER_GLOBAL, LAYER_IRRADIANCE, LAYER_LOCAL};
-use crate::output::{Layer, RgbImage};
+use crate::output::{Layer, Region, RgbImage};
 use crate::raster::VisibilityBuffer;
 use crate::scene::Scene;
 
@@ -73,6 +73,10 @@ pub struct RenderOptions<'a> {
     /// antialiasing), instead of splitting fragments whose sub-samples see different light,
     /// normals or material (the `adaptive` module). For measurements and tests.
     pub shade_once: bool,
+    /// Render only this region of the image (a tile): every pixel of it is bit for bit the
+    /// same pixel of the whole render. The image is rasterised whole; the first pass also
+    /// shades a one-pixel margin around the region, which the second pass compares with.
+    pub crop: Option<Region>,
 }
 
 /// Wall-clock time per phase.
@@ -134,10 +138,13 @@ pub struct RenderStats {
 /// A rendered image with its layers.
 #[derive(Clone, Debug)]
 pub struct Render {
-    /// Linear radiance.
+    /// Linear radiance of the rendered region.
     pub image: RgbImage,
-    /// Per-pixel breakdown, each a full-size buffer.
+    /// Per-pixel breakdown of the rendered region, row-major.
     pub pixels: Vec<PixelValue>,
+    /// The rendered region of the camera's image (all of it unless
+    /// [`RenderOptions::crop`]).
+    pub region: Region,
     /// What it took.
     pub stats: RenderStats,
 }
@@ -254,6 +261,12 @@ fn render_in_pool(
     let mut timings = Timings::default();
     let settings = &scene.render;
     let camera = &scene.camera;
+    let region = options
+        .crop
+        .unwrap_or(Region::full(camera.width, camera.height));
+    region
+        .check_within(camera.width, camera.height)
+        .map_err(RenderError::Crop)?;
 
     let t = Instant::now();
     let prep = Prepared::new(scene)?;
@@ -380,22 +393,25 @@ fn render_in_pool(
         view_proj,
         visibility: &visibility,
     };
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    let b = bar(options.progress, h as u64, "shading");
+    // The second pass compares each pixel with its eight neighbours' first-pass values, so
+    // the first pass covers a one-pixel margin around the region.
+    let refine = scene.render.aa > 1 && !options.shade_once;
+    let shaded = region.grown(u32::from(refine), camera.width, camera.height);
+    let b = bar(options.progress, u64::from(shaded.height()), "shading");
     // Shaded in place, one row per task: a single buffer, touched once (fresh pages cost a
     // fault each; rows gathered into a second buffer doubled that).
-    let mut pixels = vec![PixelValue::default(); w * h];
+    let mut pixels = vec![PixelValue::default(); shaded.pixels() as usize];
     let rows: Vec<Result<Row, RenderError>> = pixels
-        .par_chunks_mut(w.max(1))
-        .enumerate()
-        .map(|(y, out)| {
+        .par_chunks_mut(shaded.width().max(1) as usize)
+        .zip(shaded.y0..shaded.y1)
+        .map(|(out, y)| {
             let mut scratch = PixelScratch::default();
             let mut row = Row::default();
-            for (x, slot) in out.iter_mut().enumerate() {
+            for (x, slot) in (shaded.x0..shaded.x1).zip(out.iter_mut()) {
                 *slot = if options.collect_stats {
-                    shading.pixel(x as u32, y as u32, &mut scratch, &mut row.stats)?
+                    shading.pixel(x, y, &mut scratch, &mut row.stats)?
                 } else {
-                    shading.pixel(x as u32, y as u32, &mut scratch, &mut NoStats)?
+                    shading.pixel(x, y, &mut scratch, &mut NoStats)?
                 };
                 let groups = &scratch.groups.groups;
                 row.points += groups.len() as u64;
@@ -425,9 +441,10 @@ fn render_in_pool(
         queries += row.queries;
     }
     // Second pass: where the shading varies within a pixel, more points.
-    if scene.render.aa > 1 && !options.shade_once {
+    if refine {
         let t = Instant::now();
-        let refined = antialias::refine(&shading, &mut pixels, options.collect_stats)?;
+        let refined =
+            antialias::refine(&shading, &mut pixels, shaded, region, options.collect_stats)?;
         let counted = refined.stats.traversal;
         traversal.nodes_opened += counted.nodes_opened;
         traversal.aggregates += counted.aggregates;
@@ -445,15 +462,21 @@ fn render_in_pool(
     timings.shading = t.elapsed();
     timings.total = start.elapsed();
 
+    let pixels = if shaded == region {
+        pixels
+    } else {
+        region.cut(&shaded, &pixels)
+    };
     let image = RgbImage::from_pixels(
-        camera.width,
-        camera.height,
+        region.width(),
+        region.height(),
         pixels.iter().map(|p| p.color).collect(),
     )
     .map_err(RenderError::Image)?;
     Ok(Render {
         image,
         pixels,
+        region,
         stats: RenderStats {
             samples: sample_count,
             density: plan,

@@ -19,3 +19,4 @@ mod outputs;
 mod ply;
 mod scene;
 mod texture;
+mod tiles;

@@ -11,3 +11,4 @@ mod golden;
 mod meshes;
 mod render_physics;
 mod shading_aa;
+mod tiles;
