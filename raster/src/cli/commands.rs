@@ -325,6 +325,9 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
     if let Some(seed) = args.seed {
         scene.render.seed = seed;
     }
+    if let Some(method) = args.method {
+        scene.render.method = method;
+    }
     let start = std::time::Instant::now();
     let (sets, plan) =
         render::bake_planned(&scene, !args.quiet, true).map_err(|e| e.to_string())?;
@@ -338,6 +341,7 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
     let provenance = [
         format!("scene {source}"),
         format!("seed {}", scene.render.seed),
+        format!("method {}", scene.render.method),
     ];
     write_baked(&args.output, &sets, &names, &provenance).map_err(|e| e.to_string())?;
     if !args.quiet {

@@ -207,6 +207,11 @@ pub struct BakeArgs {
     /// Where to write the samples (binary PLY).
     #[arg(short, long, value_name = "OUT.ply", default_value = "samples.ply")]
     pub output: PathBuf,
+    /// The method whose rule lights the samples (default: the scene's): edge-refined lights
+    /// a sample whose cell a hard shadow's edge crosses by the mean over its cell, every other
+    /// method at the sample.
+    #[arg(long, value_parser = method_parser())]
+    pub method: Option<Method>,
     /// Irradiance samples over all translucent surfaces: `auto` (the default, unless the scene
     /// gives a count) spaces them a quarter of the smallest diffuse mean free path ℓ_d of the
     /// translucent materials apart, up to --max-samples; or a count N.

@@ -284,3 +284,50 @@ fn samples_baked_for_another_scene() {
         sb.fails(&from_samples(), 1, &["baked samples:", needle]);
     }
 }
+
+/// `bake --method` chooses how the samples are lit: both sets have the same positions and
+/// areas and name their method; edge-refined's differ from edge-aware's only where the plate's
+/// shadow edge crosses a sample's cell (the mean over the cell instead of the value at it).
+#[test]
+fn bake_method_chooses_how_the_samples_are_lit() {
+    let sb = Sandbox::new("bake-method");
+    let bake = |method: &str| {
+        let out = format!("{method}.ply");
+        sb.succeeds(&[
+            "bake",
+            "scene.toml",
+            "-q",
+            "-o",
+            &out,
+            "--samples",
+            "2000",
+            "--method",
+            method,
+        ]);
+        let ply = sb.read(&out);
+        let header = ply.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+        let text = String::from_utf8_lossy(&ply[..header]).into_owned();
+        assert!(
+            text.contains(&format!("comment method {method}\n")),
+            "{text}"
+        );
+        let floats: Vec<f32> = ply[header..]
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        floats
+    };
+    let (own, cells) = (bake("edge-aware"), bake("edge-refined"));
+    assert_eq!(own.len(), cells.len());
+    let samples: Vec<(&[f32], &[f32])> = own.chunks_exact(10).zip(cells.chunks_exact(10)).collect();
+    assert!(
+        samples.iter().all(|(a, b)| a[..7] == b[..7]),
+        "positions, normals, areas"
+    );
+    let averaged = samples.iter().filter(|(a, b)| a[7..] != b[7..]).count();
+    assert!(
+        averaged > 0 && averaged < samples.len() / 10,
+        "{averaged} of {} samples averaged",
+        samples.len()
+    );
+}
