@@ -78,13 +78,13 @@ fn quick_bench_writes_a_complete_report() {
     assert!(status.success(), "lucent bench --quick failed: {status}");
 
     // One CSV row per scene × count × method (quick: 2 counts; hierarchical, LM07, N10,
-    // edge-refined), and
-    // per scene LM07 and N10 at the sweep's other smoothing factor (k = 3).
+    // edge-refined), and per scene the three split methods at the sweep's other smoothing
+    // factor (k = 3).
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows.len(), 3 * 2 * 4 + 3 * 2, "{csv}");
+    assert_eq!(rows.len(), 3 * 2 * 4 + 3 * 3, "{csv}");
     let value = |row: &[&str], name: &str| -> f64 {
         row[column(&header, name)]
             .parse()
@@ -118,7 +118,7 @@ fn quick_bench_writes_a_complete_report() {
     let requested = column(&header, "samples_requested");
     assert_eq!(
         rows.iter().filter(|r| r[smoothing] == "3").count(),
-        3 * 2,
+        3 * 3,
         "{csv}"
     );
     let error_at = |scene: &str, method: &str, n: &str| {
