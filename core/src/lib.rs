@@ -104,7 +104,7 @@ pub use dipole::Dipole;
 pub use kd_tables::LocalIntegralByKd;
 pub use local_term::LocalTerm;
 pub use profile::{Distance, Profile};
-pub use query::{Exitance, Method, QuerySettings, ShadingPoint};
+pub use query::{Exitance, Method, QueryPlan, QuerySettings, ShadingPoint};
 pub use refine::LocalQuadrature;
 pub use table::LocalIntegralTable;
 

@@ -285,18 +285,32 @@ impl IrradianceCache {
         settings: &QuerySettings,
         stats: &mut S,
     ) -> Result<Exitance, QueryError> {
-        let local_integral = local.k();
+        // The checks in their documented order: α, the point, then K and the settings.
         let alpha = local.alpha();
         if !(alpha.is_finite() && alpha >= 0.0) {
             return Err(QueryError::InvalidLocalIntegral);
         }
-        if !point.position.is_finite() {
-            return Err(QueryError::NonFinitePosition);
+        check_point(point)?;
+        let plan = self.plan(profile, local, settings)?;
+        Ok(self.run::<L, S>(&plan, point, stats))
+    }
+
+    /// Checks `settings` and `local` and computes what every query of `profile` on this cache
+    /// shares (the kernel, N10's power-of-two scales), once: for a material that does not vary
+    /// over the surface, [`IrradianceCache::query_planned`] then skips that work at every
+    /// shading point. The plan belongs to this cache (its scales depend on the mean sample
+    /// area); its result is bit for bit [`IrradianceCache::query`]'s.
+    pub fn plan(
+        &self,
+        profile: &Profile,
+        local: LocalTerm,
+        settings: &QuerySettings,
+    ) -> Result<QueryPlan, QueryError> {
+        let alpha = local.alpha();
+        if !(alpha.is_finite() && alpha >= 0.0) {
+            return Err(QueryError::InvalidLocalIntegral);
         }
-        if !non_negative(point.irradiance) {
-            return Err(QueryError::InvalidIrradiance);
-        }
-        if !non_negative(local_integral) {
+        if !non_negative(local.k()) {
             return Err(QueryError::InvalidLocalIntegral);
         }
         settings.validate()?;
@@ -305,18 +319,60 @@ impl IrradianceCache {
         let rd_scale = rd_zero.map(reciprocal_pow2);
         let area_scale = reciprocal_pow2(self.mean_area());
         let flux_scale = pow2_clamped(f64::from(area_scale) * f64::from(FLUX_HEADROOM));
-        let params = Params {
-            epsilon: settings.epsilon,
-            cull_tolerance: settings.cull_tolerance,
-            kernel: Kernel::new(alpha),
-            irradiance: point.irradiance,
+        Ok(QueryPlan {
+            profile: *profile,
+            local,
+            method: settings.method,
+            rd_zero,
+            params: Params {
+                epsilon: settings.epsilon,
+                cull_tolerance: settings.cull_tolerance,
+                kernel: Kernel::new(alpha),
+                irradiance: Vec3::ZERO,
+                rd_scale,
+                area_scale,
+                flux_scale,
+            },
+        })
+    }
+
+    /// [`IrradianceCache::query_with_stats`] with the material's work done once
+    /// ([`IrradianceCache::plan`], on this cache): checks only the point.
+    #[inline]
+    pub fn query_planned<S: StatsSink>(
+        &self,
+        plan: &QueryPlan,
+        point: &ShadingPoint,
+        stats: &mut S,
+    ) -> Result<Exitance, QueryError> {
+        stats.query();
+        check_point(point)?;
+        Ok(self.run::<DefaultLanes, S>(plan, point, stats))
+    }
+
+    /// The query proper, its inputs checked.
+    fn run<L: Lanes, S: StatsSink>(
+        &self,
+        plan: &QueryPlan,
+        point: &ShadingPoint,
+        stats: &mut S,
+    ) -> Exitance {
+        let profile = &plan.profile;
+        let local_integral = plan.local.k();
+        let rd_zero = plan.rd_zero;
+        let Params {
             rd_scale,
             area_scale,
             flux_scale,
+            ..
+        } = plan.params;
+        let params = Params {
+            irradiance: point.irradiance,
+            ..plan.params
         };
         let x = point.position;
         let e = point.irradiance;
-        let result = match settings.method {
+        match plan.method {
             Method::Exhaustive => {
                 let global = cache::exhaustive::exhaustive_sum_lanes::<L>(self, profile, x);
                 Exitance {
@@ -339,7 +395,7 @@ impl IrradianceCache {
             }
             Method::EdgeAware | Method::EdgeRefined => {
                 let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
-                let refine = settings.method == Method::EdgeRefined
+                let refine = plan.method == Method::EdgeRefined
                     && !uniform_within(sums.irradiance_range, e, EDGE_THRESHOLD);
                 // N10: the shading point joins the kernel-weighted average at r = 0 with weight
                 // Rd(0)·Ā, in (1/4, 1] in the traversal's scaled weights (0 if Ā = 0). The
@@ -360,9 +416,40 @@ impl IrradianceCache {
                     ..split_result(sums, e_loc, local_integral)
                 }
             }
-        };
-        Ok(result)
+        }
     }
+}
+
+/// What [`IrradianceCache::plan`] computes once for a material and a cache.
+#[derive(Clone, Copy, Debug)]
+pub struct QueryPlan {
+    profile: Profile,
+    local: LocalTerm,
+    method: Method,
+    rd_zero: [f32; 3],
+    params: Params,
+}
+
+impl QueryPlan {
+    /// The local term the plan was made with.
+    pub fn local(&self) -> LocalTerm {
+        self.local
+    }
+    /// The profile the plan was made with.
+    pub fn profile(&self) -> &Profile {
+        &self.profile
+    }
+}
+
+/// The per-point checks: a finite position, a finite non-negative irradiance.
+fn check_point(point: &ShadingPoint) -> Result<(), QueryError> {
+    if !point.position.is_finite() {
+        return Err(QueryError::NonFinitePosition);
+    }
+    if !non_negative(point.irradiance) {
+        return Err(QueryError::InvalidIrradiance);
+    }
+    Ok(())
 }
 
 /// A power of two v (in f64) clamped to [2⁻¹²⁶, 2¹²⁶].

@@ -738,3 +738,67 @@ fn edge_aware_weighs_unlit_samples_of_a_node_beyond_f32_squares() {
 fn edge_aware_weighs_unlit_samples_near_f32_max() {
     assert_unlit_surface_weighed(3.2e38, 50, 43);
 }
+
+/// A plan made once per material gives every method's result bit for bit, and its checks are
+/// the query's: bad settings and K fail at planning, a bad point at the query.
+#[test]
+fn planned_queries_equal_plain_ones_bit_for_bit() {
+    let cache = IrradianceCache::build(&sphere_samples(3000, 1.0, 7)).unwrap();
+    let p = profile(0.05);
+    let local = term(0.04, Vec3::new(0.3, 0.2, 0.1));
+    for method in Method::ALL {
+        let s = settings(method, 0.4, 1e-4);
+        let plan = cache.plan(&p, local, &s).unwrap();
+        assert_eq!(plan.local(), local);
+        for x in query_points(200, 3) {
+            let mut counted = (QueryStats::default(), QueryStats::default());
+            let want = cache
+                .query_with_stats(&p, &point(x), local, &s, &mut counted.0)
+                .unwrap();
+            let got = cache
+                .query_planned(&plan, &point(x), &mut counted.1)
+                .unwrap();
+            assert_eq!(got, want, "{method:?} at {x}");
+            assert_eq!(counted.0, counted.1, "{method:?} at {x}");
+        }
+    }
+    let bad = settings(Method::Hierarchical, f32::NAN, 1e-4);
+    assert!(matches!(
+        cache.plan(&p, local, &bad),
+        Err(QueryError::InvalidSetting {
+            name: "epsilon",
+            ..
+        })
+    ));
+    assert_eq!(
+        cache
+            .plan(
+                &p,
+                term(0.04, Vec3::new(-1.0, 0.0, 0.0)),
+                &settings(Method::LocalGlobal, 0.4, 0.0)
+            )
+            .unwrap_err(),
+        QueryError::InvalidLocalIntegral
+    );
+    let plan = cache
+        .plan(&p, local, &settings(Method::EdgeAware, 0.4, 1e-4))
+        .unwrap();
+    let nan = ShadingPoint {
+        position: Vec3::new(f32::NAN, 0.0, 0.0),
+        irradiance: Vec3::ONE,
+    };
+    assert_eq!(
+        cache.query_planned(&plan, &nan, &mut NoStats).unwrap_err(),
+        QueryError::NonFinitePosition
+    );
+    let negative = ShadingPoint {
+        position: Vec3::ZERO,
+        irradiance: Vec3::new(0.0, -1.0, 0.0),
+    };
+    assert_eq!(
+        cache
+            .query_planned(&plan, &negative, &mut NoStats)
+            .unwrap_err(),
+        QueryError::InvalidIrradiance
+    );
+}

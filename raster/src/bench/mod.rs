@@ -11,9 +11,11 @@
 //!     claim 1:  per count, the three methods at equal ε on one baked sample set, rendered
 //!               in interleaved rounds (overhead.rs): medians of per-round ratios
 //!     sphere:   exhaustive sum at 18.5k samples vs hierarchical at several ε (speed claim)
+//!               peer comparison (peer.rs): one lookup per pixel, one thread, relRMSE against
+//!               the exhaustive sum, CPU per lookup beside pbrt-v2's; one against two threads
 //!     textured: the power-of-two K table against K by quadrature at every pixel
 //!     default:  the shipped `lucent` render at 512², written to PNG + EXR, timed end to end
-//! report: report.md, results.csv, overhead.csv, <scene>-error-vs-time.svg,
+//! report: report.md, results.csv, overhead.csv, peer.csv, <scene>-error-vs-time.svg,
 //!         <scene>-edge-error-vs-time.svg, <scene>-figure1.png
 //! ```
 //!
@@ -34,6 +36,7 @@
 mod charts;
 mod figures;
 mod overhead;
+mod peer;
 mod report;
 mod runner;
 mod scenes;
@@ -45,6 +48,7 @@ use std::time::{Duration, Instant};
 
 pub use charts::{ChartPoint, chart_files, replot, write_charts};
 pub use overhead::{OverheadRow, Spread};
+pub use peer::{PBRT_V2, PEER_LEVELS, PeerConfig, PeerPoint, PeerReport, PeerRow};
 pub use report::{write_csv, write_markdown, write_overhead_csv};
 pub use runner::{MethodSetting, Reference, RunResult};
 pub use scenes::BenchScene;
@@ -196,6 +200,8 @@ pub struct BenchConfig {
     pub scenes: Vec<BenchScene>,
     /// Worker threads (`None` = all cores).
     pub threads: Option<usize>,
+    /// The peer comparison (run with the sphere scene; `None` = skip).
+    pub peer: Option<PeerConfig>,
 }
 
 impl BenchConfig {
@@ -218,6 +224,7 @@ impl BenchConfig {
             end_to_end: true,
             scenes: BenchScene::ALL.to_vec(),
             threads: None,
+            peer: Some(PeerConfig::full()),
         }
     }
 
@@ -240,6 +247,7 @@ impl BenchConfig {
             end_to_end: false,
             scenes: BenchScene::ALL.to_vec(),
             threads: None,
+            peer: Some(PeerConfig::quick()),
         }
     }
 
@@ -413,6 +421,8 @@ pub struct BenchReport {
     pub table: Option<TableCheck>,
     /// The default scene end to end (render + PNG + EXR).
     pub end_to_end: Option<Duration>,
+    /// The peer comparison on the sphere, if run.
+    pub peer: Option<PeerReport>,
     /// Per scene, the caption of its contact sheet (what its rows and columns show).
     pub figure_captions: Vec<(BenchScene, String)>,
     /// Worker threads.
@@ -444,6 +454,7 @@ pub fn run(
         overhead: Vec::new(),
         table: None,
         end_to_end: None,
+        peer: None,
         figure_captions: Vec::new(),
         threads: 0,
         wall: Duration::ZERO,
@@ -462,6 +473,9 @@ pub fn run(
     write_markdown(&report, &out.join("report.md"))?;
     write_csv(&report, &out.join("results.csv"))?;
     write_overhead_csv(&report, &out.join("overhead.csv"))?;
+    if let Some(peer) = &report.peer {
+        crate::output::write_text_atomically(&out.join("peer.csv"), &peer::csv(peer))?;
+    }
     log(&format!(
         "report: {} ({:.0} s)",
         out.join("report.md").display(),
@@ -608,6 +622,9 @@ fn run_scene(
         }
         BenchScene::Sphere => {
             report.exhaustive = exhaustive_check(config, &base, log)?;
+            if let Some(peer) = &config.peer {
+                report.peer = Some(peer::run(peer, log)?);
+            }
         }
         BenchScene::Default => {}
     }
@@ -780,6 +797,25 @@ fn exhaustive_check(
         });
     }
     Ok(rows)
+}
+
+/// Runs the peer comparison alone (`lucent bench --peer`), writing `peer.md` and `peer.csv`
+/// into `out` (created if needed).
+pub fn run_peer(
+    config: &PeerConfig,
+    out: &Path,
+    log: &mut dyn FnMut(&str),
+) -> Result<PeerReport, BenchError> {
+    std::fs::create_dir_all(out).map_err(|source| BenchError::CreateDir {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let report = peer::run(config, log)?;
+    let md = format!("# lucent bench --peer\n\n{}", peer::markdown(&report));
+    crate::output::write_text_atomically(&out.join("peer.md"), &md)?;
+    crate::output::write_text_atomically(&out.join("peer.csv"), &peer::csv(&report))?;
+    log(&format!("report: {}", out.join("peer.md").display()));
+    Ok(report)
 }
 
 /// The shipped default render, timed from loading the scene to the renamed output files.

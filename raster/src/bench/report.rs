@@ -423,6 +423,9 @@ pub fn write_markdown(report: &BenchReport, path: &Path) -> Result<(), BenchErro
             }
         }
     }
+    if let Some(peer) = &report.peer {
+        let _ = writeln!(s, "\n{}", super::peer::markdown(peer));
+    }
     write_file(path, &s)
 }
 

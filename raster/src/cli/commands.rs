@@ -405,6 +405,25 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
         }
         return Ok(());
     }
+    if args.peer {
+        let mut peer = if args.quick {
+            bench::PeerConfig::quick()
+        } else {
+            bench::PeerConfig::full()
+        };
+        if let Some(r) = args.resolution {
+            check((16..=4096).contains(&r), "--resolution", r, "16 to 4096")?;
+            peer.resolution = r;
+        }
+        let quiet = args.quiet;
+        bench::run_peer(&peer, &args.output, &mut |line| {
+            if !quiet {
+                eprintln!("{line}");
+            }
+        })
+        .map_err(|e| format!("bench: {e}"))?;
+        return Ok(());
+    }
     let mut config = if args.quick {
         BenchConfig::quick()
     } else {

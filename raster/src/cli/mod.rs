@@ -249,6 +249,10 @@ pub struct BenchArgs {
     /// A small version (96², two sample counts) that finishes in well under a minute.
     #[arg(long)]
     pub quick: bool,
+    /// Run only the peer comparison (sphere, one lookup per pixel, one thread: CPU per lookup
+    /// against relRMSE beside pbrt-v2's), writing peer.md and peer.csv; about a minute.
+    #[arg(long)]
+    pub peer: bool,
     /// Only these scenes (default, sphere, textured), comma-separated.
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     pub scenes: Vec<String>,

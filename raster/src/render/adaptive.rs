@@ -191,6 +191,7 @@ impl Shading<'_> {
             fragments,
             shadows,
             groups,
+            ..
         } = scratch;
         self.visibility
             .resolve(x, y, |t| object_of[t as usize], fragments);

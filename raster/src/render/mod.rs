@@ -42,7 +42,9 @@ pub use density::{DensityOrigin, DensityPlan};
 pub use error::RenderError;
 pub use irradiance::ObjectSamples;
 pub use prepare::{Prepared, can_occlude};
-pub use shading::{ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounters, ShadingStats};
+pub use shading::{
+    ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounters, ShadingStats, UniformMaterial,
+};
 
 use crate::lights::Lighting;
 use crate::material::{MaterialError, Shader};
@@ -318,6 +320,11 @@ fn render_in_pool(
         Cow::Owned(sets) => irradiance::build_caches_releasing(sets)?,
     };
     let mut caches: Vec<Option<ObjectCache>> = (0..scene.objects.len()).map(|_| None).collect();
+    let query_settings = QuerySettings {
+        method,
+        epsilon: settings.epsilon,
+        cull_tolerance: settings.cull_tolerance,
+    };
     let mut cache_bytes = 0;
     let local_term = |object: usize, alpha: f32| match prep.shader_of(object) {
         Shader::Translucent(shader) if method.is_split() && alpha > 0.0 => {
@@ -346,6 +353,7 @@ fn render_in_pool(
             alpha,
             local,
             translucent_shader(object),
+            &query_settings,
         )?);
     }
     // A translucent object far smaller than the sample spacing can receive no sample at all.
@@ -366,6 +374,7 @@ fn render_in_pool(
                 alpha,
                 local_term(object, alpha)?,
                 translucent_shader(object),
+                &query_settings,
             )?);
         }
     }
@@ -382,11 +391,7 @@ fn render_in_pool(
         prep: &prep,
         lighting,
         caches,
-        settings: QuerySettings {
-            method,
-            epsilon: settings.epsilon,
-            cull_tolerance: settings.cull_tolerance,
-        },
+        settings: query_settings,
         exact_local_integral: options.exact_local_integral,
         irradiance_everywhere: options.irradiance_layer || scene.output.layers.irradiance,
         camera,
@@ -404,14 +409,15 @@ fn render_in_pool(
     let rows: Vec<Result<Row, RenderError>> = pixels
         .par_chunks_mut(shaded.width().max(1) as usize)
         .zip(shaded.y0..shaded.y1)
-        .map(|(out, y)| {
-            let mut scratch = PixelScratch::default();
+        // One scratch per rayon job, not per row: its buffers and the last triangle's set-up
+        // are reused along the job's rows (the values do not depend on it).
+        .map_init(PixelScratch::default, |scratch, (out, y)| {
             let mut row = Row::default();
             for (x, slot) in (shaded.x0..shaded.x1).zip(out.iter_mut()) {
                 *slot = if options.collect_stats {
-                    shading.pixel(x, y, &mut scratch, &mut row.stats)?
+                    shading.pixel(x, y, scratch, &mut row.stats)?
                 } else {
-                    shading.pixel(x, y, &mut scratch, &mut NoStats)?
+                    shading.pixel(x, y, scratch, &mut NoStats)?
                 };
                 let groups = &scratch.groups.groups;
                 row.points += groups.len() as u64;

@@ -13,16 +13,18 @@ use std::time::{Duration, Instant};
 use glam::{Mat4, Vec2, Vec3};
 use lucent_core::internals::fresnel;
 use lucent_core::stats::{NoStats, QueryStats, StatsSink};
-use lucent_core::{IrradianceCache, LocalQuadrature, LocalTerm, QuerySettings, ShadingPoint};
+use lucent_core::{
+    IrradianceCache, LocalQuadrature, LocalTerm, QueryPlan, QuerySettings, ShadingPoint,
+};
 
 use super::RenderError;
 use super::adaptive::GroupScratch;
-use super::attributes::SurfaceAttributes;
+use super::attributes::{SurfaceAttributes, TriangleSetup};
 use super::edge_refined::{self, RefinePoint};
 use super::prepare::Prepared;
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
-use crate::material::{LocalIntegral, MaterialError, Shader, TranslucentShader};
+use crate::material::{LocalIntegral, MaterialError, PointMaterial, Shader, TranslucentShader};
 use crate::raster::{Fragment, VisibilityBuffer};
 use crate::sampling::rng::splitmix64;
 
@@ -42,16 +44,29 @@ pub struct ObjectCache {
     /// The edge-refined quadrature when the material does not vary (textured materials build
     /// theirs at each refined point).
     pub quadrature: Option<LocalQuadrature>,
+    /// When the material does not vary over the surface: the material, and the query's checks
+    /// and constants done once ([`IrradianceCache::plan`]) instead of at every shading point.
+    pub uniform: Option<UniformMaterial>,
+}
+
+/// A material that does not vary over the surface, resolved once for an object.
+#[derive(Clone, Copy, Debug)]
+pub struct UniformMaterial {
+    /// The material (the same at every point).
+    pub point: PointMaterial,
+    /// The query's plan for it on the object's cache.
+    pub plan: QueryPlan,
 }
 
 impl ObjectCache {
-    /// The object's cache, smoothing radius and local term; K is computed once, exactly, for a
-    /// material that does not vary.
+    /// The object's cache, smoothing radius and local term; K is computed once, exactly, and
+    /// the query planned once ([`ObjectCache::uniform`]) for a material that does not vary.
     pub fn new(
         cache: IrradianceCache,
         alpha: f32,
         local: Option<LocalIntegral>,
         shader: Option<&TranslucentShader>,
+        settings: &QuerySettings,
     ) -> Result<ObjectCache, RenderError> {
         let (uniform_k, quadrature) = match (&local, shader) {
             (Some(term), Some(shader)) if !shader.is_textured() => {
@@ -68,12 +83,32 @@ impl ObjectCache {
             }
             _ => (None, None),
         };
+        let uniform = match shader {
+            Some(shader) if !shader.is_textured() => {
+                let local = match (&local, uniform_k) {
+                    (Some(_), Some(term)) => Some(term),
+                    (None, _) => Some(LocalTerm::NONE),
+                    (Some(_), None) => None,
+                };
+                // A plan the settings or K reject is not made: every point then reports the
+                // error itself, as without a plan.
+                match (local, shader.at(Vec2::ZERO)) {
+                    (Some(local), Ok(point)) => cache
+                        .plan(&point.profile, local, settings)
+                        .ok()
+                        .map(|plan| UniformMaterial { point, plan }),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
         Ok(ObjectCache {
             cache,
             alpha,
             local,
             uniform_k,
             quadrature,
+            uniform,
         })
     }
 }
@@ -175,6 +210,8 @@ pub struct PixelScratch {
     pub shadows: ShadowHints,
     /// The pixel's shading points (its fragments, split where the shading varies).
     pub groups: GroupScratch,
+    /// The last triangle's shared attributes, kept from pixel to pixel.
+    pub(crate) triangle: TriangleSetup,
 }
 
 /// The read-only state every pixel is shaded from.
@@ -228,7 +265,10 @@ impl Shading<'_> {
         stats: &mut S,
     ) -> Result<PixelValue, RenderError> {
         let PixelScratch {
-            shadows, groups, ..
+            shadows,
+            groups,
+            triangle,
+            ..
         } = scratch;
         let mut value = PixelValue::default();
         let aa = self.visibility.aa();
@@ -240,7 +280,7 @@ impl Shading<'_> {
             let seed = group.seed(splitmix64(pixel_index * 16 + group.source as u64));
             let timed = S::TIMED && self.caches[fragment.key as usize].is_some();
             let start = timed.then(Instant::now);
-            let s = self.surface(fragment, seed, shadows, stats)?;
+            let s = self.surface(fragment, seed, shadows, triangle, stats)?;
             if let Some(start) = start {
                 stats.translucent_time(start.elapsed());
             }
@@ -263,6 +303,7 @@ impl Shading<'_> {
         fragment: &Fragment,
         seed: u64,
         shadows: &mut ShadowHints,
+        triangle: &mut TriangleSetup,
         stats: &mut S,
     ) -> Result<Surface, RenderError> {
         let prep = self.prep;
@@ -273,7 +314,7 @@ impl Shading<'_> {
             geometric,
             uv,
             view,
-        } = self.attributes(object, fragment.triangle, fragment.sample);
+        } = self.attributes_on(object, fragment.triangle, fragment.sample, triangle);
         let cos_out = outgoing_cosine(normal, geometric, view);
         let mut out = Surface {
             position,
@@ -290,12 +331,21 @@ impl Shading<'_> {
                 let oc = self.caches[object].as_ref().ok_or_else(|| {
                     RenderError::Core(format!("no irradiance cache for object {object}"))
                 })?;
-                let point = shader.at(uv).map_err(|e| {
-                    RenderError::Material(MaterialError::Params {
-                        material: shader.name.clone(),
-                        source: e,
-                    })
-                })?;
+                // K by quadrature at every point (a measurement option) bypasses the plan.
+                let uniform = oc.uniform.as_ref().filter(|_| !self.exact_local_integral);
+                let at_point;
+                let point = match uniform {
+                    Some(u) => &u.point,
+                    None => {
+                        at_point = shader.at(uv).map_err(|e| {
+                            RenderError::Material(MaterialError::Params {
+                                material: shader.name.clone(),
+                                source: e,
+                            })
+                        })?;
+                        &at_point
+                    }
+                };
                 let method = self.settings.method;
                 let mut e = Vec3::ZERO;
                 let mut highlight = Vec3::ZERO;
@@ -315,32 +365,40 @@ impl Shading<'_> {
                         }
                     });
                 }
-                let local = match (&oc.local, oc.uniform_k) {
-                    (Some(_), _) if self.exact_local_integral => {
-                        LocalTerm::exact(&point.profile, oc.alpha).map_err(|e| {
-                            RenderError::Material(MaterialError::Params {
-                                material: shader.name.clone(),
-                                source: e,
-                            })
-                        })?
-                    }
-                    (Some(_), Some(term)) => term,
-                    (Some(source), None) => source.lookup(&point),
-                    (None, _) => LocalTerm::NONE,
+                let shading_point = ShadingPoint {
+                    position,
+                    irradiance: e,
                 };
-                let m = oc
-                    .cache
-                    .query_with_stats(
-                        &point.profile,
-                        &ShadingPoint {
-                            position,
-                            irradiance: e,
-                        },
-                        local,
-                        &self.settings,
-                        stats,
-                    )
-                    .map_err(|source| RenderError::Query { position, source })?;
+                let (local, m) = match uniform {
+                    Some(u) => (
+                        u.plan.local(),
+                        oc.cache.query_planned(&u.plan, &shading_point, stats),
+                    ),
+                    None => {
+                        let local = match (&oc.local, oc.uniform_k) {
+                            (Some(_), _) if self.exact_local_integral => {
+                                LocalTerm::exact(&point.profile, oc.alpha).map_err(|e| {
+                                    RenderError::Material(MaterialError::Params {
+                                        material: shader.name.clone(),
+                                        source: e,
+                                    })
+                                })?
+                            }
+                            (Some(_), Some(term)) => term,
+                            (Some(source), None) => source.lookup(point),
+                            (None, _) => LocalTerm::NONE,
+                        };
+                        let m = oc.cache.query_with_stats(
+                            &point.profile,
+                            &shading_point,
+                            local,
+                            &self.settings,
+                            stats,
+                        );
+                        (local, m)
+                    }
+                };
+                let m = m.map_err(|source| RenderError::Query { position, source })?;
                 let m = if m.refine {
                     let q = oc
                         .quadrature
@@ -444,6 +502,7 @@ mod tests {
                 alpha,
                 Some(local),
                 Some(&shader),
+                &QuerySettings::default(),
             )
             .unwrap();
             let got = oc.uniform_k.expect("uniform material");

@@ -177,8 +177,19 @@ fn quick_bench_writes_a_complete_report() {
         "Where the error comes from",
         "### 3. Texture-mapped",
         "### 4. Speed",
+        "## Peer comparison",
+        "pbrt-v2 dipolesubsurface",
+        "One against two threads",
     ] {
         assert!(report.contains(needle), "report.md lacks '{needle}'");
+    }
+    // The peer curve: one row per ε of the quick sweep, errors and times positive.
+    let peer = std::fs::read_to_string(out.join("peer.csv")).unwrap();
+    let peer_rows: Vec<&str> = peer.lines().skip(1).collect();
+    assert_eq!(peer_rows.len(), 3, "{peer}");
+    for row in peer_rows {
+        let cells: Vec<f64> = row.split(',').map(|c| c.parse().unwrap()).collect();
+        assert!(cells[..5].iter().all(|&v| v > 0.0), "{row}");
     }
     let labels = [
         "hierarchical eps=0.5",
@@ -249,4 +260,28 @@ fn bench_rejects_bad_options_with_a_message() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("results.csv"), "{stderr}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn the_peer_comparison_runs_alone() {
+    let out = scratch("bench-peer");
+    let status = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["bench", "--peer", "--quick", "--quiet", "-o"])
+        .arg(&out)
+        .status()
+        .expect("run lucent");
+    assert!(
+        status.success(),
+        "lucent bench --peer --quick failed: {status}"
+    );
+    let md = std::fs::read_to_string(out.join("peer.md")).unwrap();
+    assert!(
+        md.contains("| relRMSE | lucent µs | pbrt-v2 µs | ratio |"),
+        "{md}"
+    );
+    assert!(out.join("peer.csv").exists());
+    assert!(
+        !out.join("report.md").exists(),
+        "--peer writes only its own files"
+    );
 }
