@@ -267,9 +267,40 @@ impl IrradianceCache {
         self.query_with::<DefaultLanes, S>(profile, point, local, settings, stats)
     }
 
+    /// [`IrradianceCache::query_with_stats`] compiled for AVX2: the traversal in 256-bit
+    /// registers, one ymm register per eight lanes where the baseline x86-64 build uses two
+    /// SSE registers (`wide::f32x8` fixes its representation when the crate is compiled).
+    /// The result is bit-identical to [`IrradianceCache::query_with_stats`]: the same IEEE-754
+    /// operations in the same order, without fused multiply-add.
+    ///
+    /// # Safety
+    ///
+    /// A `#[target_feature]` function: calling it from code not itself compiled for AVX2 is
+    /// `unsafe`, and sound only on a CPU with AVX2 (check with
+    /// `std::is_x86_feature_detected!("avx2")`, once). The `lucent` renderer does this in one
+    /// place, `raster/src/render/simd.rs`.
+    #[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
+    #[target_feature(enable = "avx2")]
+    pub fn query_with_stats_avx2<S: StatsSink>(
+        &self,
+        profile: &Profile,
+        point: &ShadingPoint,
+        local: LocalTerm,
+        settings: &QuerySettings,
+        stats: &mut S,
+    ) -> Result<Exitance, QueryError> {
+        stats.query();
+        // `ArrayLanes` inlines the whole traversal here (`Lanes::INLINE_TRAVERSAL`), so that all
+        // of it is compiled for AVX2.
+        self.query_with::<crate::lanes::ArrayLanes, S>(profile, point, local, settings, stats)
+    }
+
     /// [`IrradianceCache::query_with_stats`] with an explicit lane type (SIMD or scalar): for
     /// benchmarks and for testing the two lane types against each other. Not part of the API.
+    /// Always inlined, so that [`IrradianceCache::query_with_stats_avx2`] compiles all of it
+    /// for AVX2 (for the other lane types the traversal itself stays out of line).
     #[doc(hidden)]
+    #[inline(always)]
     pub fn query_with<L: Lanes, S: StatsSink>(
         &self,
         profile: &Profile,

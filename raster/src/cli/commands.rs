@@ -255,7 +255,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         let s = &result.stats;
         let t = &s.timings;
         outln!(
-            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
+            "lucent: {}×{}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads, simd {} → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
@@ -278,6 +278,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             seconds(start.elapsed()),
             s.cache_bytes as f64 / 1e6,
             s.threads,
+            s.simd,
             written.join(", ")
         );
     }

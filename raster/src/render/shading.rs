@@ -328,19 +328,18 @@ impl Shading<'_> {
                     (Some(source), None) => source.lookup(&point),
                     (None, _) => LocalTerm::NONE,
                 };
-                let m = oc
-                    .cache
-                    .query_with_stats(
-                        &point.profile,
-                        &ShadingPoint {
-                            position,
-                            irradiance: e,
-                        },
-                        local,
-                        &self.settings,
-                        stats,
-                    )
-                    .map_err(|source| RenderError::Query { position, source })?;
+                let m = super::simd::query(
+                    &oc.cache,
+                    &point.profile,
+                    &ShadingPoint {
+                        position,
+                        irradiance: e,
+                    },
+                    local,
+                    &self.settings,
+                    stats,
+                )
+                .map_err(|source| RenderError::Query { position, source })?;
                 let m = if m.refine {
                     let q = oc
                         .quadrature
