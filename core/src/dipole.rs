@@ -381,7 +381,14 @@ impl Dipole {
         let s_a4 = sigma2 * a4;
         let k1 = s_a4 - L::splat(7.0) * b4 * inv_r2;
         let (s_a9, s_b4) = (L::splat(9.0) * s_a4, sigma2 * b4);
-        let source = |z: f32, z2: f32| {
+        // The real and the virtual source, in a loop rather than a closure: the AVX2 traversal
+        // inlines all of this into one function, where a closure was left as an out-of-line
+        // call compiled without AVX2.
+        let sources = [(self.z_r, self.z_r2), (self.z_v, self.z_v2)];
+        let mut values = [L::splat(0.0); 2];
+        let mut corrections = [L::splat(0.0); 2];
+        for k in 0..2 {
+            let (z, z2) = sources[k];
             let d2 = r2 + L::splat(z2);
             let d = d2.sqrt();
             let u = sigma * d;
@@ -391,7 +398,7 @@ impl Dipole {
             let rho = r2 * t;
             // w = z e/d³ (k = w t); the value is w θ₁.
             let w = L::splat(z) * (e / (d * d2));
-            let value = w * (u + one);
+            values[k] = w * (u + one);
             // θ₂ = u² + 3u + 3 and θ₃ = (u + 3)(θ₂ + 3) − 3 (six operations instead of ten,
             // and (u + 3)(θ₂ + 3) ≥ 18, so no cancellation).
             let three = L::splat(3.0);
@@ -400,13 +407,10 @@ impl Dipole {
             let p3 = u3 * (p2 + three) - three;
             let coeff3 = rho * (k0 + rho * (k1 + rho * a63));
             let coeff2 = rho * (rho * s_a9 - s_b4) - half_trace;
-            let correction = w * t * (p3 * coeff3 + p2 * coeff2);
-            (value, correction)
-        };
-        let (tr, cr) = source(self.z_r, self.z_r2);
-        let (tv, cv) = source(self.z_v, self.z_v2);
-        let plain = tr + tv;
-        let corrected = plain + cr + cv;
+            corrections[k] = w * t * (p3 * coeff3 + p2 * coeff2);
+        }
+        let plain = values[0] + values[1];
+        let corrected = plain + corrections[0] + corrections[1];
         L::splat(self.scale) * corrected.max(L::splat(0.0)).min(plain + plain)
     }
 

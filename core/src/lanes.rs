@@ -6,7 +6,11 @@
 //! - [`SimdLanes`] (feature `simd`, the default): `wide::f32x8` — two SSE registers on baseline
 //!   x86-64, one AVX register where enabled, NEON pairs on aarch64;
 //! - [`ScalarLanes`]: a plain `[f32; 8]` evaluated lane by lane with libm — the fallback, and
-//!   the reference the SIMD path is tested against.
+//!   the reference the SIMD path is tested against;
+//! - [`ArrayLanes`] (feature `simd`): an aligned `[f32; 8]` with the arithmetic of
+//!   [`SimdLanes`], written for the compiler's vectoriser — the lane type of the AVX2
+//!   traversal ([`crate::IrradianceCache::query_planned_avx2`]), where it is one ymm
+//!   register.
 //!
 //! [`DefaultLanes`] is what the public query API uses.
 //!
@@ -66,6 +70,11 @@ pub trait Lanes:
 {
     /// A short name for benchmarks and test messages.
     const NAME: &'static str;
+    /// Whether the traversal is inlined whole into its caller. False: the profile evaluation
+    /// and each mode's traversal stay out of line (`cache/traverse.rs` says why). True for a
+    /// lane type compiled inside a `#[target_feature]` function, where an out-of-line call
+    /// would be compiled without the feature.
+    const INLINE_TRAVERSAL: bool = false;
     /// All lanes `v`.
     fn splat(v: f32) -> Self;
     /// The first eight values of `src` (callers guarantee `src.len() >= 8` through padding).
@@ -197,8 +206,34 @@ impl Lanes for ScalarLanes {
     }
 }
 
+/// Lane masks as floats with all bits set, indexed by an 8-bit lane mask (`keep` of the SIMD
+/// lane types: one load and an `and`).
+#[cfg(feature = "simd")]
+const fn lane_mask_table() -> [[u32; LANES]; 256] {
+    let mut t = [[0u32; LANES]; 256];
+    let mut m = 0;
+    while m < 256 {
+        let mut i = 0;
+        while i < LANES {
+            if m & (1 << i) != 0 {
+                t[m][i] = u32::MAX;
+            }
+            i += 1;
+        }
+        m += 1;
+    }
+    t
+}
+#[cfg(feature = "simd")]
+pub(crate) static LANE_MASKS: [[u32; LANES]; 256] = lane_mask_table();
+
 #[cfg(feature = "simd")]
 pub use simd::SimdLanes;
+
+#[cfg(feature = "simd")]
+mod array;
+#[cfg(feature = "simd")]
+pub use array::ArrayLanes;
 
 #[cfg(feature = "simd")]
 mod simd {
@@ -224,24 +259,6 @@ mod simd {
     simd_binop!(Sub, sub, -);
     simd_binop!(Mul, mul, *);
     simd_binop!(Div, div, /);
-
-    /// Lane masks as floats with all bits set, indexed by an 8-bit lane mask.
-    const fn lane_mask_table() -> [[u32; LANES]; 256] {
-        let mut t = [[0u32; LANES]; 256];
-        let mut m = 0;
-        while m < 256 {
-            let mut i = 0;
-            while i < LANES {
-                if m & (1 << i) != 0 {
-                    t[m][i] = u32::MAX;
-                }
-                i += 1;
-            }
-            m += 1;
-        }
-        t
-    }
-    static LANE_MASKS: [[u32; LANES]; 256] = lane_mask_table();
 
     impl Lanes for SimdLanes {
         const NAME: &'static str = "simd";
@@ -328,5 +345,73 @@ mod tests {
     #[test]
     fn simd_lanes_ops() {
         check_ops::<SimdLanes>();
+    }
+
+    #[cfg(feature = "simd")]
+    #[test]
+    fn array_lanes_ops() {
+        check_ops::<ArrayLanes>();
+    }
+
+    /// Every operation of [`ArrayLanes`] gives the bits of [`SimdLanes`], on values that
+    /// include ±0, subnormals, infinities and NaN.
+    #[cfg(feature = "simd")]
+    #[test]
+    fn array_lanes_equal_simd_lanes_bit_for_bit() {
+        let specials = [
+            0.0,
+            -0.0,
+            1e-40,
+            -1e-40,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            f32::MAX,
+            -87.4,
+            -3.25,
+            2.5,
+            1e30,
+        ];
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            match state % 4 {
+                0 => specials[(state >> 8) as usize % specials.len()],
+                1 => f32::from_bits((state >> 32) as u32),
+                _ => ((state >> 40) as f32 / 16_777_216.0 - 0.75) * 200.0,
+            }
+        };
+        // Bits, except that any NaN equals any other (the compiler may commute the operands
+        // of an addition or a product, and with them which NaN payload propagates).
+        let bits = |l: [f32; LANES]| l.map(|v| if v.is_nan() { u32::MAX } else { v.to_bits() });
+        for _ in 0..20_000 {
+            let a: [f32; LANES] = core::array::from_fn(|_| next());
+            let b: [f32; LANES] = core::array::from_fn(|_| next());
+            let (sa, sb) = (SimdLanes::load(&a), SimdLanes::load(&b));
+            let (aa, ab) = (ArrayLanes::load(&a), ArrayLanes::load(&b));
+            let pairs = [
+                ((sa + sb).to_array(), (aa + ab).to_array()),
+                ((sa - sb).to_array(), (aa - ab).to_array()),
+                ((sa * sb).to_array(), (aa * ab).to_array()),
+                ((sa / sb).to_array(), (aa / ab).to_array()),
+                (sa.sqrt().to_array(), aa.sqrt().to_array()),
+                (
+                    sa.exp_nonpositive().to_array(),
+                    aa.exp_nonpositive().to_array(),
+                ),
+                (sa.min(sb).to_array(), aa.min(ab).to_array()),
+                (sa.max(sb).to_array(), aa.max(ab).to_array()),
+            ];
+            for (s, r) in pairs {
+                assert_eq!(bits(s), bits(r), "a = {a:?}, b = {b:?}");
+            }
+            assert_eq!(sa.lt(sb), aa.lt(ab));
+            let m = Mask((a[0].to_bits() ^ b[1].to_bits()) & 0xff);
+            assert_eq!(bits(sa.keep(m).to_array()), bits(aa.keep(m).to_array()));
+            let sums = (sa.reduce_add(), aa.reduce_add());
+            assert_eq!(bits([sums.0; LANES]), bits([sums.1; LANES]));
+        }
     }
 }

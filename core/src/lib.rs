@@ -124,7 +124,7 @@ pub mod internals {
     };
     pub use crate::kernel::Kernel;
     #[cfg(feature = "simd")]
-    pub use crate::lanes::SimdLanes;
+    pub use crate::lanes::{ArrayLanes, SimdLanes};
     pub use crate::lanes::{DefaultLanes, LANES, Lanes, Mask, ScalarLanes};
     pub use crate::morton::Grid;
     pub use crate::profile::{KD_MAX, KD_MIN};

@@ -178,6 +178,32 @@ mod wide_exp {
 #[cfg(feature = "simd")]
 pub use wide_exp::exp_nonpositive_x8;
 
+/// One lane of [`exp_nonpositive_x8`], the same operations in the same order, branch-free so
+/// that a loop of eight calls vectorises (the AVX2 traversal's [`crate::lanes::ArrayLanes`]).
+/// 2^n is assembled without a float-to-int conversion: n + (2²³ + 127) is exact (n is an
+/// integer in [−126, 0]) and holds n + 127 in its low mantissa bits, which the shift moves
+/// into the exponent field while the shift drops the rest: the bits of the conversion route.
+#[cfg(feature = "simd")]
+#[inline(always)]
+pub(crate) fn exp_nonpositive_lane(x: f32) -> f32 {
+    let underflow = x < EXP_MIN_ARG;
+    // `minps`/`maxps` semantics (the second operand where either is NaN), as the 8-lane
+    // version: NaN lanes are restored below.
+    let xc = if x > EXP_MIN_ARG { x } else { EXP_MIN_ARG };
+    let xc = if xc < 0.0 { xc } else { 0.0 };
+    let magic = 12_582_912.0_f32;
+    let n = (xc * core::f32::consts::LOG2_E + magic) - magic;
+    let r = (xc - n * LN2_HI) - n * LN2_LO;
+    let c = EXP_POLY;
+    let p = c[0] + r * (c[1] + r * (c[2] + r * (c[3] + r * (c[4] + r * c[5]))));
+    let e = 1.0 + r + r * r * p;
+    let scale = f32::from_bits((n + 8_388_735.0).to_bits() << 23);
+    #[allow(clippy::eq_op)] // x − x is the point: 0, or NaN
+    let nan_or_zero = x - x;
+    let v = e * scale + nan_or_zero;
+    if underflow { 0.0 } else { v }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,6 +264,39 @@ mod tests {
         assert_eq!(got[2], 0.0);
         assert!(got[3] > 0.0);
         assert_eq!(got[4], 1.0);
+    }
+
+    #[cfg(feature = "simd")]
+    #[test]
+    fn exp_lane_equals_x8_bit_for_bit() {
+        use wide::f32x8;
+        let mut lanes = [0.0_f32; 8];
+        let mut x = -95.0_f32;
+        let mut i = 0;
+        let check = |lanes: [f32; 8]| {
+            let want = exp_nonpositive_x8(f32x8::from(lanes)).to_array();
+            for (w, l) in want.iter().zip(lanes) {
+                assert_eq!(w.to_bits(), exp_nonpositive_lane(l).to_bits(), "x = {l}");
+            }
+        };
+        while x <= 1.0 {
+            lanes[i % 8] = x;
+            i += 1;
+            if i % 8 == 0 {
+                check(lanes);
+            }
+            x += 0.001_37;
+        }
+        check([
+            f32::NAN,
+            f32::NEG_INFINITY,
+            f32::INFINITY,
+            -87.3,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::MAX,
+        ]);
     }
 
     #[test]

@@ -274,9 +274,40 @@ impl IrradianceCache {
         self.query_with::<DefaultLanes, S>(profile, point, local, settings, stats)
     }
 
+    /// [`IrradianceCache::query_planned`] compiled for AVX2: the traversal in 256-bit
+    /// registers, one ymm register per eight lanes where the baseline x86-64 build uses two
+    /// SSE registers (`wide::f32x8` fixes its representation when the crate is compiled).
+    /// The result is bit-identical to [`IrradianceCache::query_planned`]: the same IEEE-754
+    /// operations in the same order, without fused multiply-add. (An unplanned query is
+    /// [`IrradianceCache::plan`] and then this.)
+    ///
+    /// # Safety
+    ///
+    /// A `#[target_feature]` function: calling it from code not itself compiled for AVX2 is
+    /// `unsafe`, and sound only on a CPU with AVX2 (check with
+    /// `std::is_x86_feature_detected!("avx2")`, once). The `lucent` renderer does this in one
+    /// place, `raster/src/render/simd.rs`.
+    #[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
+    #[target_feature(enable = "avx2")]
+    pub fn query_planned_avx2<S: StatsSink>(
+        &self,
+        plan: &QueryPlan,
+        point: &ShadingPoint,
+        stats: &mut S,
+    ) -> Result<Exitance, QueryError> {
+        stats.query();
+        check_point(point)?;
+        // `ArrayLanes` inlines the whole traversal here (`Lanes::INLINE_TRAVERSAL`), so that all
+        // of it is compiled for AVX2.
+        Ok(self.run::<crate::lanes::ArrayLanes, S>(plan, point, stats))
+    }
+
     /// [`IrradianceCache::query_with_stats`] with an explicit lane type (SIMD or scalar): for
     /// benchmarks and for testing the two lane types against each other. Not part of the API.
+    /// Always inlined (for the lane types other than `ArrayLanes` the traversal itself stays
+    /// out of line).
     #[doc(hidden)]
+    #[inline(always)]
     pub fn query_with<L: Lanes, S: StatsSink>(
         &self,
         profile: &Profile,
@@ -350,7 +381,9 @@ impl IrradianceCache {
         Ok(self.run::<DefaultLanes, S>(plan, point, stats))
     }
 
-    /// The query proper, its inputs checked.
+    /// The query proper, its inputs checked. Always inlined, so that
+    /// [`IrradianceCache::query_planned_avx2`] compiles all of it for AVX2.
+    #[inline(always)]
     fn run<L: Lanes, S: StatsSink>(
         &self,
         plan: &QueryPlan,

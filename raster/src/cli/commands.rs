@@ -289,7 +289,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             format!(", crop {r} ({}×{})", r.width(), r.height())
         });
         outln!(
-            "lucent: {}×{}{crop}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads → {}",
+            "lucent: {}×{}{crop}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads, simd {} → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
@@ -311,6 +311,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             seconds(start.elapsed()),
             s.cache_bytes as f64 / 1e6,
             s.threads,
+            s.simd,
             written.join(", ")
         );
     }

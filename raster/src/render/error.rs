@@ -10,6 +10,8 @@ use crate::output::OutputError;
 use crate::raster::RasterError;
 use crate::sampling::SamplingError;
 
+use super::simd::SimdError;
+
 /// Why a render failed. A variant that wraps another error returns it from
 /// [`source`](std::error::Error::source).
 #[derive(Debug)]
@@ -44,6 +46,8 @@ pub enum RenderError {
     Core(String),
     /// The thread pool could not be started.
     Threads(rayon::ThreadPoolBuildError),
+    /// `LUCENT_SIMD` asks for a traversal path this CPU cannot run, or none at all.
+    Simd(SimdError),
 }
 
 impl fmt::Display for RenderError {
@@ -63,6 +67,7 @@ impl fmt::Display for RenderError {
             RenderError::Image(e) => write!(f, "internal error: {e}"),
             RenderError::Core(m) => write!(f, "internal error: {m}"),
             RenderError::Threads(e) => write!(f, "thread pool: {e}"),
+            RenderError::Simd(e) => write!(f, "{e}"),
         }
     }
 }
@@ -77,6 +82,7 @@ impl std::error::Error for RenderError {
             RenderError::Query { source, .. } => Some(source),
             RenderError::Cache(e) => Some(e),
             RenderError::Threads(e) => Some(e),
+            RenderError::Simd(e) => Some(e),
             RenderError::Baked(_)
             | RenderError::Limit(_)
             | RenderError::Crop(_)

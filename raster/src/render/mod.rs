@@ -25,6 +25,7 @@ mod error;
 mod irradiance;
 mod prepare;
 mod shading;
+pub mod simd;
 
 use std::borrow::Cow;
 use std::time::{Duration, Instant};
@@ -135,6 +136,8 @@ pub struct RenderStats {
     pub timings: Timings,
     /// Threads used.
     pub threads: usize,
+    /// The traversal's instruction set ([`simd::selected`]).
+    pub simd: simd::Simd,
 }
 
 /// A rendered image with its layers.
@@ -260,6 +263,7 @@ fn render_in_pool(
     threads: usize,
 ) -> Result<Render, RenderError> {
     let start = Instant::now();
+    let simd = simd::selected().map_err(RenderError::Simd)?;
     let mut timings = Timings::default();
     let settings = &scene.render;
     let camera = &scene.camera;
@@ -497,6 +501,7 @@ fn render_in_pool(
             translucent_time: options.collect_stats.then_some(translucent_time),
             timings,
             threads,
+            simd,
         },
     })
 }

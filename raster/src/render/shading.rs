@@ -372,7 +372,7 @@ impl Shading<'_> {
                 let (local, m) = match uniform {
                     Some(u) => (
                         u.plan.local(),
-                        oc.cache.query_planned(&u.plan, &shading_point, stats),
+                        super::simd::query_planned(&oc.cache, &u.plan, &shading_point, stats),
                     ),
                     None => {
                         let local = match (&oc.local, oc.uniform_k) {
@@ -388,7 +388,8 @@ impl Shading<'_> {
                             (Some(source), None) => source.lookup(point),
                             (None, _) => LocalTerm::NONE,
                         };
-                        let m = oc.cache.query_with_stats(
+                        let m = super::simd::query(
+                            &oc.cache,
                             &point.profile,
                             &shading_point,
                             local,

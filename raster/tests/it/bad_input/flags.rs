@@ -212,3 +212,39 @@ fn sample_count_summary_and_warning() {
         "{stderr}"
     );
 }
+
+/// `LUCENT_SIMD` naming no traversal path, or AVX2 on a CPU without it: exit 1, naming the
+/// variable, before anything is written. Each path prints its name on the summary line, and
+/// the two write the same bytes.
+#[test]
+fn simd_environment_variable() {
+    let sb = Sandbox::new("simd-bad").with_env("LUCENT_SIMD", "sse9");
+    sb.fails(
+        &render(&[]),
+        1,
+        &["LUCENT_SIMD=\"sse9\"", "baseline, avx2 or auto"],
+    );
+
+    let run = |simd: &'static str| {
+        let sb = Sandbox::new("simd-path").with_env("LUCENT_SIMD", simd);
+        let out = sb.succeeds(&["scene.toml"]);
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            stdout.contains(&format!("threads, simd {simd} →")),
+            "{stdout}"
+        );
+        (sb.read("out.png"), sb.read("out.exr"))
+    };
+    let baseline = run("baseline");
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    if std::is_x86_feature_detected!("avx2") {
+        assert!(baseline == run("avx2"), "the AVX2 path wrote other bytes");
+    } else {
+        let sb = Sandbox::new("simd-avx2").with_env("LUCENT_SIMD", "avx2");
+        sb.fails(
+            &render(&[]),
+            1,
+            &["LUCENT_SIMD=avx2", "does not support AVX2"],
+        );
+    }
+}

@@ -116,6 +116,7 @@ pub fn scene(object: &str, material: &str) -> String {
 /// drop.
 pub struct Sandbox {
     dir: PathBuf,
+    env: Vec<(&'static str, &'static str)>,
 }
 
 impl Sandbox {
@@ -132,10 +133,19 @@ impl Sandbox {
             std::env::temp_dir().join(format!("lucent-bad-input-{tag}-{}-{n}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("create the sandbox");
-        let sandbox = Sandbox { dir };
+        let sandbox = Sandbox {
+            dir,
+            env: Vec::new(),
+        };
         sandbox.write("scene.toml", text.as_bytes());
         sandbox.reset_outputs();
         sandbox
+    }
+
+    /// The sandbox, running the binary with the environment variable `key` set to `value`.
+    pub fn with_env(mut self, key: &'static str, value: &'static str) -> Sandbox {
+        self.env.push((key, value));
+        self
     }
 
     /// A path inside the sandbox.
@@ -191,6 +201,7 @@ impl Sandbox {
             .args(args)
             .current_dir(&self.dir)
             .env_remove("RAYON_NUM_THREADS")
+            .envs(self.env.iter().copied())
             .output()
             .expect("start the lucent binary")
     }
