@@ -89,6 +89,7 @@ pub mod presets;
 mod profile;
 mod quadrature;
 mod query;
+mod random_walk;
 mod refine;
 mod seed;
 pub mod stats;
@@ -155,5 +156,11 @@ pub mod internals {
     /// Morton codes of quantised positions.
     pub mod morton {
         pub use crate::morton::*;
+    }
+    /// The Monte Carlo reference for diffusion profiles: a random walk in a semi-infinite
+    /// medium scored as a radial profile, Chandrasekhar's H-function, and the comparison of a
+    /// model's profile with the walk's.
+    pub mod random_walk {
+        pub use crate::random_walk::*;
     }
 }

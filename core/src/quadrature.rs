@@ -61,6 +61,18 @@ impl<const N: usize> GaussLegendre<N> {
         sum * half
     }
 
+    /// The rule's nodes and weights mapped to [a, b], as (x_i, w_i) with
+    /// Σ w_i f(x_i) = [`GaussLegendre::integrate`]`(a, b, f)` up to rounding: for integral
+    /// equations, whose unknown is kept at the nodes.
+    pub fn points(&self, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let half = 0.5 * (b - a);
+        let mid = 0.5 * (a + b);
+        self.nodes
+            .iter()
+            .zip(&self.weights)
+            .map(move |(&x, &w)| (mid + half * x, w * half))
+    }
+
     /// (∫_a^b f₀ dx, ∫_a^b f₁ dx) for f(x) = (f₀(x), f₁(x)), from one evaluation of f per node
     /// (for two integrands that share an expensive factor). Each component is summed as
     /// [`GaussLegendre::integrate`] would, so it gets the same bits.
@@ -116,6 +128,16 @@ mod tests {
         let (p, q) = rule.integrate_pair(a, b, |x| (math::exp64(-x), x * x * math::cos64(x)));
         assert_eq!(p, rule.integrate(a, b, |x| math::exp64(-x)));
         assert_eq!(q, rule.integrate(a, b, |x| x * x * math::cos64(x)));
+    }
+
+    #[test]
+    fn points_reproduce_the_integral() {
+        let rule = GaussLegendre::<12>::new();
+        let (a, b) = (0.5, 2.0);
+        let sum: f64 = rule.points(a, b).map(|(x, w)| w * math::exp64(-x)).sum();
+        let want = math::exp64(-0.5) - math::exp64(-2.0);
+        assert!((sum - want).abs() < 1e-14, "{sum} vs {want}");
+        assert!(rule.points(a, b).all(|(x, w)| x > a && x < b && w > 0.0));
     }
 
     #[test]
