@@ -51,7 +51,7 @@ use crate::math;
 use crate::seed::splitmix64;
 
 pub use chandrasekhar::HFunction;
-pub use compare::{COMPARE_RANGE, ProfileComparison, compare, compare_over};
+pub use compare::{COMPARE_RANGE, ProfileComparison, annulus_mean, compare, compare_over};
 pub use rng::Xoshiro256;
 
 /// Photons per chunk: the unit of seeding and of parallel work.

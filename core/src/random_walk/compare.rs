@@ -63,7 +63,7 @@ pub fn compare_over(
             empty_bins += 1;
             continue;
         }
-        let mean = annulus_mean(&rule, &model, profile.edges[i], profile.edges[i + 1]);
+        let mean = annulus_mean_with(&rule, &model, profile.edges[i], profile.edges[i + 1]);
         let relative = (mean - walk) / walk;
         absolute += relative.abs();
         signed += relative;
@@ -79,9 +79,15 @@ pub fn compare_over(
     }
 }
 
-/// The mean of R over the annulus a ≤ r ≤ b: ∫ R(r) 2πr dr / π(b² − a²), integrated in
-/// u = ln r (dr = r du), where a log-spaced bin's integrand is smooth and nearly polynomial.
-fn annulus_mean(rule: &GaussLegendre<8>, model: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+/// The mean of a model's R over the annulus a ≤ r ≤ b, as the walk scores it:
+/// ∫ R(r) 2πr dr / π(b² − a²) by an 8-point Gauss–Legendre rule in ln r.
+pub fn annulus_mean(model: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    annulus_mean_with(&GaussLegendre::<8>::new(), &model, a, b)
+}
+
+/// [`annulus_mean`] with the rule made once: integrated in u = ln r (dr = r du), where a
+/// log-spaced bin's integrand is smooth and nearly polynomial.
+fn annulus_mean_with(rule: &GaussLegendre<8>, model: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     let integral = rule.integrate(math::ln64(a), math::ln64(b), |u| {
         let r = math::exp64(u);
         model(r) * 2.0 * core::f64::consts::PI * r * r

@@ -19,6 +19,10 @@
 //!         <scene>-edge-error-vs-time.svg, <scene>-figure1.png
 //! ```
 //!
+//! `lucent bench --peer` runs the peer comparison alone ([`run_peer`]); `lucent bench
+//! --profiles` measures the diffusion profiles against the core's Monte Carlo random walk
+//! ([`run_profiles`], `profiles.rs`).
+//!
 //! **Ground truth.** The natural truth is the exhaustive sum over a sample set much denser
 //! than the test sets. At 16 × 100k samples that is 1.6 M profile evaluations per pixel —
 //! hours on two cores — and a point sum without smoothing converges slowly anyway: each
@@ -37,6 +41,7 @@ mod charts;
 mod figures;
 mod overhead;
 mod peer;
+mod profiles;
 mod report;
 mod runner;
 mod scenes;
@@ -49,6 +54,10 @@ use std::time::{Duration, Instant};
 pub use charts::{ChartPoint, chart_files, replot, write_charts};
 pub use overhead::{OverheadRow, Spread};
 pub use peer::{PBRT_V2, PEER_LEVELS, PeerConfig, PeerPoint, PeerReport, PeerRow};
+pub use profiles::{
+    CheckRow, MODELS, ModelCurve, ModelEntry, ModelInput, ProfilesConfig, ProfilesReport,
+    WalkResult,
+};
 pub use report::{write_csv, write_markdown, write_overhead_csv};
 pub use runner::{MethodSetting, Reference, RunResult};
 pub use scenes::BenchScene;
@@ -815,6 +824,30 @@ pub fn run_peer(
     crate::output::write_text_atomically(&out.join("peer.md"), &md)?;
     crate::output::write_text_atomically(&out.join("peer.csv"), &peer::csv(&report))?;
     log(&format!("report: {}", out.join("peer.md").display()));
+    Ok(report)
+}
+
+/// Runs the diffusion profiles against the Monte Carlo random walk alone (`lucent bench
+/// --profiles`), writing `profiles.md`, `profiles.csv`, `profile-bins.csv` and the profile
+/// charts into `out` (created if needed).
+pub fn run_profiles(
+    config: &ProfilesConfig,
+    out: &Path,
+    log: &mut dyn FnMut(&str),
+) -> Result<ProfilesReport, BenchError> {
+    std::fs::create_dir_all(out).map_err(|source| BenchError::CreateDir {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let report = profiles::run(config, log)?;
+    crate::output::write_text_atomically(&out.join("profiles.md"), &profiles::markdown(&report))?;
+    crate::output::write_text_atomically(&out.join("profiles.csv"), &profiles::csv(&report))?;
+    crate::output::write_text_atomically(
+        &out.join("profile-bins.csv"),
+        &profiles::bins_csv(&report),
+    )?;
+    profiles::write_plots(&report, out)?;
+    log(&format!("report: {}", out.join("profiles.md").display()));
     Ok(report)
 }
 

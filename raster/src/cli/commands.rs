@@ -406,6 +406,22 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
         }
         return Ok(());
     }
+    if args.profiles {
+        let mut config = if args.quick {
+            bench::ProfilesConfig::quick()
+        } else {
+            bench::ProfilesConfig::full()
+        };
+        config.threads = args.threads;
+        let quiet = args.quiet;
+        bench::run_profiles(&config, &args.output, &mut |line| {
+            if !quiet {
+                eprintln!("{line}");
+            }
+        })
+        .map_err(|e| format!("bench: {e}"))?;
+        return Ok(());
+    }
     if args.peer {
         let mut peer = if args.quick {
             bench::PeerConfig::quick()
