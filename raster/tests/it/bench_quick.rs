@@ -285,3 +285,34 @@ fn the_peer_comparison_runs_alone() {
         "--peer writes only its own files"
     );
 }
+
+#[test]
+fn the_profiles_comparison_runs_alone() {
+    let out = scratch("bench-profiles");
+    let status = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["bench", "--profiles", "--quick", "--quiet", "-o"])
+        .arg(&out)
+        .status()
+        .expect("run lucent");
+    assert!(
+        status.success(),
+        "lucent bench --profiles --quick failed: {status}"
+    );
+    let md = std::fs::read_to_string(out.join("profiles.md")).unwrap();
+    assert!(md.contains("## classical dipole"), "{md}");
+    // α′ = 0.99 in the totals table and in every model's.
+    let rows = md.lines().filter(|l| l.starts_with("| 0.99 |")).count();
+    assert_eq!(rows, 1 + lucent_raster::bench::MODELS.len());
+    for file in [
+        "profiles.csv",
+        "profile-bins.csv",
+        "profile-pencil-0.95.svg",
+    ] {
+        assert!(out.join(file).exists(), "{file}");
+    }
+    assert!(
+        !out.join("report.md").exists(),
+        "--profiles writes only its own files"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
