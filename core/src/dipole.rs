@@ -18,7 +18,7 @@ use crate::math;
 
 /// Squared distances are clamped to this before evaluation so that d³ overflows to +∞ (and Rd
 /// to 0) instead of producing ∞ · 0 = NaN for absurdly distant samples.
-const MAX_R2: f32 = 1e36;
+pub(crate) const MAX_R2: f32 = 1e36;
 
 /// The boundary term A = (1 + F_dr)/(1 − F_dr) with the J01 internal F_dr fit.
 pub fn boundary_term(eta: f64) -> f64 {
@@ -61,30 +61,42 @@ pub fn albedo_from_total_reflectance(kd: f64, eta: f64) -> f64 {
     1.0 - s * s / 3.0
 }
 
-/// A precomputed inverse of Rd_total for one η: K_d → α′ by table lookup, for texture-mapped
-/// reflectance (one inversion per shading point; bisection would cost ~60 exponentials).
+/// A precomputed inverse of Rd_total for one model and η: K_d → the model's albedo parameter by
+/// table lookup, for texture-mapped reflectance (one inversion per shading point; bisection
+/// would cost ~60 exponentials).
 ///
-/// Tabulates s = √(3(1 − α′)) on a uniform grid of K_d ∈ [0, 1] (s is smooth in K_d at both
-/// ends, unlike α′) and interpolates linearly: α′ = 1 − s²/3. Accurate to about 1e-6 in K_d
-/// (test `albedo_inverter_matches_bisection`).
-#[derive(Clone, Debug, PartialEq)]
+/// For the dipoles it tabulates s = √(3(1 − α′)) on a uniform grid of K_d ∈ [0, 1] (s is
+/// smooth in K_d at both ends, unlike α′) and interpolates linearly: α′ = 1 − s²/3. Accurate to
+/// about 1e-6 in K_d (test `albedo_inverter_matches_bisection`). Burley's albedo is K_d itself.
+#[derive(Clone, Debug)]
 pub struct AlbedoInverter {
     eta: f32,
+    model: crate::profile::ProfileModel,
     s: alloc::vec::Vec<f32>,
 }
 
 impl AlbedoInverter {
     const SIZE: usize = 4096;
 
-    /// Builds the table for relative index `eta` (≥ 1; callers validate).
+    /// Builds the classical dipole's table for relative index `eta` (≥ 1; callers validate).
     pub fn new(eta: f32) -> Self {
-        let s = (0..=Self::SIZE)
-            .map(|i| {
-                let kd = (i as f64 / Self::SIZE as f64).clamp(1e-9, 1.0 - 1e-12);
-                math::sqrt64(3.0 * (1.0 - albedo_from_total_reflectance(kd, eta as f64))) as f32
-            })
-            .collect();
-        AlbedoInverter { eta, s }
+        Self::for_model(crate::profile::ProfileModel::Dipole, eta)
+    }
+
+    /// Builds the table of `model` for relative index `eta` (≥ 1; callers validate).
+    pub fn for_model(model: crate::profile::ProfileModel, eta: f32) -> Self {
+        let s = if let crate::profile::ProfileModel::Burley(_) = model {
+            alloc::vec::Vec::new()
+        } else {
+            (0..=Self::SIZE)
+                .map(|i| {
+                    let kd = (i as f64 / Self::SIZE as f64).clamp(1e-9, 1.0 - 1e-12);
+                    let albedo = model.albedo_from_total_reflectance(kd, eta as f64);
+                    math::sqrt64(3.0 * (1.0 - albedo)) as f32
+                })
+                .collect()
+        };
+        AlbedoInverter { eta, model, s }
     }
 
     /// The η the table was built for.
@@ -92,14 +104,22 @@ impl AlbedoInverter {
         self.eta
     }
 
-    /// α′ with Rd_total(α′) = `kd` (clamped into [0, 1]).
+    /// The model's albedo parameter whose total reflectance is `kd` (clamped into [0, 1]).
     #[inline]
     pub fn albedo(&self, kd: f32) -> f64 {
+        if self.s.is_empty() {
+            return kd.clamp(0.0, 1.0) as f64;
+        }
         let x = kd.clamp(0.0, 1.0) * Self::SIZE as f32;
         let i = (x as usize).min(Self::SIZE - 1);
         let t = x - i as f32;
         let s = (self.s[i] + (self.s[i + 1] - self.s[i]) * t) as f64;
         1.0 - s * s / 3.0
+    }
+
+    /// The model the table inverts.
+    pub fn model(&self) -> crate::profile::ProfileModel {
+        self.model
     }
 }
 
@@ -434,6 +454,10 @@ impl Dipole {
     pub fn sigma_tr(&self) -> f32 {
         self.sigma_tr
     }
+    /// σ_tr, the decay rate of Rd (the traversal's culling starts from it).
+    pub fn decay_rate(&self) -> f32 {
+        self.sigma_tr
+    }
     /// Mean free path ℓ_u = 1/σ_t′ (N10's ℓ_u).
     pub fn mean_free_path(&self) -> f32 {
         self.z_r
@@ -454,7 +478,7 @@ impl Dipole {
 
 /// The dipole with ℓ_u = 1 in double precision: the unitless shape that the scaling law
 /// stretches, Rd_ℓ(r) = Rd_1(r/ℓ)/ℓ². Used by the local-integral quadrature.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UnitDipole {
     sigma_tr: f64,
     z_v: f64,

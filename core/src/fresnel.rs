@@ -54,6 +54,26 @@ pub fn diffuse_reflectance_exact(eta: f64) -> f64 {
     2.0 * total
 }
 
+/// The Fresnel moment Cₙ = ∫₀¹ F_r(η, μ) μⁿ dμ of d'Eon's better dipole (2012), for light
+/// meeting the boundary from the side of relative index 1/`eta` (pass 1/η for the internal
+/// moments of a medium of index η). 2C₁ is [`diffuse_reflectance_exact`].
+pub fn moment(eta: f64, n: u32) -> f64 {
+    let rule = GaussLegendre::<32>::new();
+    let power = |mu: f64| (0..n).fold(1.0, |acc, _| acc * mu);
+    let f = |mu: f64| reflectance(eta, mu) * power(mu);
+    let mu_c = if eta < 1.0 {
+        math::sqrt64(1.0 - eta * eta)
+    } else {
+        0.0
+    };
+    // ∫₀^μc μⁿ dμ under total internal reflection.
+    let mut total = power(mu_c) * mu_c / (n as f64 + 1.0);
+    let split = mu_c + (1.0 - mu_c) * 0.25;
+    total += rule.integrate(mu_c, split, f);
+    total += rule.integrate(split, 1.0, f);
+    total
+}
+
 /// pbrt-v2's polynomial fit of the external diffuse reflectance, evaluated at x = 1/η
 /// (`docs/physics.md` §3). Kept to cross-check [`diffuse_reflectance_exact`].
 pub fn diffuse_reflectance_external_fit(eta: f64) -> f64 {
@@ -106,6 +126,22 @@ mod tests {
         assert!((diffuse_reflectance_external_fit(1.3) - 0.0618).abs() < 1e-4);
         for (eta, want) in EXTERNAL {
             assert!((diffuse_reflectance_external_fit(eta) - want).abs() < 0.003);
+        }
+    }
+
+    /// 2C₁ is the diffuse reflectance; every moment of a perfect mirror (η → 0 side) is
+    /// 1/(n + 1); index-matched boundaries reflect nothing.
+    #[test]
+    fn moments() {
+        for eta in [1.1, 1.3, 1.5, 2.0] {
+            let c1 = moment(1.0 / eta, 1);
+            assert!((2.0 * c1 - diffuse_reflectance_exact(1.0 / eta)).abs() < 1e-12);
+            assert!(moment(1.0 / eta, 2) < c1 && moment(1.0 / eta, 2) > 0.0);
+        }
+        assert!(moment(1.0, 1).abs() < 1e-15 && moment(1.0, 2).abs() < 1e-15);
+        for n in 0..4 {
+            let m = moment(1e-9, n);
+            assert!((m - 1.0 / (n as f64 + 1.0)).abs() < 1e-6, "{n}: {m}");
         }
     }
 

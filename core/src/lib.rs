@@ -74,6 +74,8 @@
 
 extern crate alloc;
 
+mod better_dipole;
+mod burley;
 mod cache;
 mod cell_average;
 mod dipole;
@@ -84,6 +86,7 @@ mod kernel;
 mod lanes;
 mod local_term;
 mod math;
+mod moments;
 mod morton;
 pub mod presets;
 mod profile;
@@ -94,17 +97,20 @@ mod refine;
 mod seed;
 pub mod stats;
 mod table;
+mod unit_profile;
 
 /// The vector types of the API (`Vec3` for positions and RGB values), re-exported so that an
 /// embedder uses the same glam version.
 pub use glam;
 
+pub use better_dipole::BetterDipole;
+pub use burley::{Burley, BurleyFit};
 pub use cache::{IrradianceCache, Sample};
 pub use cell_average::CellAverage;
 pub use dipole::Dipole;
 pub use kd_tables::LocalIntegralByKd;
 pub use local_term::LocalTerm;
-pub use profile::{Distance, Profile};
+pub use profile::{Distance, Profile, ProfileModel};
 pub use query::{Exitance, Method, QueryPlan, QuerySettings, ShadingPoint};
 pub use refine::LocalQuadrature;
 pub use table::LocalIntegralTable;
@@ -115,6 +121,8 @@ pub use table::LocalIntegralTable;
 /// notice; an embedder should not use it.
 #[doc(hidden)]
 pub mod internals {
+    pub use crate::better_dipole::{Boundary, UnitBetterDipole};
+    pub use crate::burley::{UnitBurley, disc_average, polynomial_exp_integral};
     pub use crate::cache::{
         LEAF_CAPACITY, MAX_DEPTH, MAX_SAMPLES, NODE_BYTES, SAMPLE_BYTES, exhaustive_edge_aware,
         exhaustive_local_global, exhaustive_sum, exhaustive_sum_lanes,
@@ -125,7 +133,7 @@ pub mod internals {
     };
     pub use crate::kernel::Kernel;
     #[cfg(feature = "simd")]
-    pub use crate::lanes::{ArrayLanes, SimdLanes};
+    pub use crate::lanes::SimdLanes;
     pub use crate::lanes::{DefaultLanes, LANES, Lanes, Mask, ScalarLanes};
     pub use crate::morton::Grid;
     pub use crate::profile::{KD_MAX, KD_MIN};
@@ -138,6 +146,7 @@ pub mod internals {
         exact_local_integral, local_integral_and_slope_unit, local_integral_slope_unit,
         local_integral_unit,
     };
+    pub use crate::unit_profile::{UnitProfile, UnitShape};
 
     /// A local term with any α and K, not computed together: for testing the queries against
     /// the exhaustive oracles at chosen K (the API hands out only K computed for its α).

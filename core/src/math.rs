@@ -19,6 +19,12 @@ pub fn exp64(x: f64) -> f64 {
     libm::exp(x)
 }
 
+/// eˣ − 1 without cancellation near 0 (libm).
+#[inline]
+pub fn expm1_64(x: f64) -> f64 {
+    libm::expm1(x)
+}
+
 /// √x (libm; exact IEEE rounding).
 #[inline]
 pub fn sqrt(x: f32) -> f32 {

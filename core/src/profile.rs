@@ -1,16 +1,32 @@
-//! The RGB diffusion profile of a material: three [`Dipole`] channels sharing one η, built from
-//! coefficients, from artist parameters (K_d with a distance, JB02 §4) or from a measured
+//! The RGB diffusion profile of a material: three channels of one model sharing one η, built
+//! from coefficients, from artist parameters (K_d with a distance, JB02 §4) or from a measured
 //! preset; plus the conversion from exitance to radiance (the project's convention,
 //! `docs/physics.md` §17).
+//!
+//! The models (`docs/physics.md` §19):
+//!
+//! | [`ProfileModel`] | channel type | albedo parameter | total reflectance |
+//! |---|---|---|---|
+//! | `Dipole` (default; J01, the seed's) | [`Dipole`] | α′ | closed form, inverted for K_d |
+//! | `BetterDipole` (d'Eon 2012) | [`BetterDipole`] | α′ | closed form, inverted for K_d |
+//! | `Burley(fit)` (Christensen & Burley 2015) | [`Burley`] | A = K_d | A |
+//!
+//! Every model takes its lengths from the mean free path ℓ_u = 1/σ_t′. The traversal evaluates
+//! a profile through [`Profile::rd_lanes`] and [`Profile::rd_lanes_corrected`], one `match` per
+//! batch of eight: the classical dipole inlined into the traversal (the hot path), the others
+//! in a call of their own.
 
 use glam::Vec3;
 
+use crate::better_dipole::{self, BetterDipole, Boundary};
+use crate::burley::{Burley, BurleyFit};
 use crate::dipole::{self, Dipole, NodeMoments};
 use crate::error::ParamError;
 use crate::fresnel;
 use crate::lanes::Lanes;
 use crate::math;
 use crate::presets::Preset;
+use crate::unit_profile::UnitProfile;
 
 /// K_d is clamped into [`KD_MIN`, `KD_MAX`] before inversion, so that α′ stays representable
 /// (1 − α′ must not round to 0, nor α′ to 0). Values in (0, 1) outside this band are accepted
@@ -25,14 +41,88 @@ pub const KD_MAX: f32 = 1.0 - 1e-5;
 pub enum Distance {
     /// ℓ_u = 1/σ_t′, the mean free path: N10's ℓ_u, pbrt-v3's `mfp`.
     MeanFreePath(Vec3),
-    /// ℓ_d = 1/σ_tr, the diffuse mean free path: JB02's and pbrt-v2's `meanfreepath`.
+    /// ℓ_d = 1/σ_tr, the diffuse mean free path: JB02's and pbrt-v2's `meanfreepath`. For
+    /// every model it is converted with the classical dipole's relation,
+    /// ℓ_u = ℓ_d √(3(1 − α′)) with α′ = Rd_total⁻¹(K_d), so that one (K_d, ℓ_d) means the same
+    /// ℓ_u whatever the model.
     DiffuseMeanFreePath(Vec3),
 }
 
-/// A material's dipole profile, per RGB channel.
+/// The diffusion model of a profile.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ProfileModel {
+    /// The classical dipole of Jensen et al. 2001 (the seed's, and the default).
+    #[default]
+    Dipole,
+    /// d'Eon's better dipole (2012).
+    BetterDipole,
+    /// Christensen & Burley's normalised diffusion (2015) with one of its fits of d.
+    Burley(BurleyFit),
+}
+
+impl ProfileModel {
+    /// Every model.
+    pub const ALL: [ProfileModel; 4] = [
+        ProfileModel::Dipole,
+        ProfileModel::BetterDipole,
+        ProfileModel::Burley(BurleyFit::Searchlight),
+        ProfileModel::Burley(BurleyFit::DiffuseTransmission),
+    ];
+
+    /// A short name (`dipole`, `better-dipole`, `burley`, `burley-diffuse`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ProfileModel::Dipole => "dipole",
+            ProfileModel::BetterDipole => "better-dipole",
+            ProfileModel::Burley(BurleyFit::Searchlight) => "burley",
+            ProfileModel::Burley(BurleyFit::DiffuseTransmission) => "burley-diffuse",
+        }
+    }
+
+    /// The model's total reflectance for its albedo parameter (α′ for the dipoles, A for
+    /// Burley) and η.
+    pub fn total_reflectance(self, albedo: f64, eta: f64) -> f64 {
+        match self {
+            ProfileModel::Dipole => dipole::total_reflectance(albedo, eta),
+            ProfileModel::BetterDipole => better_dipole::total_reflectance(albedo, eta),
+            ProfileModel::Burley(_) => albedo,
+        }
+    }
+
+    /// The albedo parameter whose total reflectance is `kd` ∈ (0, 1) (callers validate).
+    pub fn albedo_from_total_reflectance(self, kd: f64, eta: f64) -> f64 {
+        match self {
+            ProfileModel::Dipole => dipole::albedo_from_total_reflectance(kd, eta),
+            ProfileModel::BetterDipole => better_dipole::albedo_from_total_reflectance(kd, eta),
+            ProfileModel::Burley(_) => kd,
+        }
+    }
+}
+
+/// The three channels, one model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Channels {
+    Dipole([Dipole; 3]),
+    BetterDipole([BetterDipole; 3], Boundary),
+    Burley([Burley; 3], BurleyFit),
+}
+
+/// Applies an expression to the channel array of whichever model (the channel types share
+/// their method names).
+macro_rules! each_model {
+    ($profile:expr, $c:ident => $e:expr) => {
+        match &$profile.channels {
+            Channels::Dipole($c) => $e,
+            Channels::BetterDipole($c, _) => $e,
+            Channels::Burley($c, _) => $e,
+        }
+    };
+}
+
+/// A material's diffusion profile, per RGB channel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Profile {
-    channels: [Dipole; 3],
+    channels: Channels,
     eta: f32,
     /// 1 / (π (1 − F_dr,ext(η))), the exitance → radiance factor (`docs/physics.md` §17).
     radiance_scale: f32,
@@ -61,12 +151,19 @@ fn check_distance(name: &'static str, v: f32) -> Result<(), ParamError> {
     }
 }
 
+/// Three fallible channel constructions in one array.
+fn try_channels<T>(
+    mut f: impl FnMut(usize) -> Result<T, ParamError>,
+) -> Result<[T; 3], ParamError> {
+    Ok([f(0)?, f(1)?, f(2)?])
+}
+
 impl Profile {
     /// Largest accepted relative index of refraction η (the constructors reject larger ones).
     pub const MAX_ETA: f32 = dipole::MAX_ETA;
 
     /// Assembles a profile from three channels with the same η.
-    fn from_channels(channels: [Dipole; 3], eta: f32) -> Self {
+    fn from_channels(channels: Channels, eta: f32) -> Self {
         let fdr_ext = fresnel::diffuse_reflectance_exact(eta as f64);
         let radiance_scale = (1.0 / (core::f64::consts::PI * (1.0 - fdr_ext))) as f32;
         Profile {
@@ -76,37 +173,64 @@ impl Profile {
         }
     }
 
-    /// From absorption σ_a and reduced scattering σ_s′ per channel (per scene unit) and η.
+    /// From absorption σ_a and reduced scattering σ_s′ per channel (per scene unit) and η:
+    /// the classical dipole.
     pub fn from_coefficients(
         sigma_a: Vec3,
         sigma_s_prime: Vec3,
         eta: f32,
     ) -> Result<Self, ParamError> {
-        let mut ch = [None; 3];
-        for (c, slot) in ch.iter_mut().enumerate() {
-            *slot = Some(Dipole::from_coefficients(
-                sigma_a[c],
-                sigma_s_prime[c],
-                eta,
-            )?);
+        Self::from_coefficients_with(ProfileModel::Dipole, sigma_a, sigma_s_prime, eta)
+    }
+
+    /// From σ_a and σ_s′ under any model: the dipoles take α′ = σ_s′/σ_t′ and σ_t′ as they are;
+    /// Burley, whose parameters are a surface albedo and ℓ, takes ℓ = 1/σ_t′ and for A the better
+    /// dipole's total reflectance of α′ (the closer of the two dipoles to transport, measured
+    /// in `BENCHMARKS.md`, "Profiles against a Monte Carlo random walk").
+    pub fn from_coefficients_with(
+        model: ProfileModel,
+        sigma_a: Vec3,
+        sigma_s_prime: Vec3,
+        eta: f32,
+    ) -> Result<Self, ParamError> {
+        dipole::check_eta(eta)?;
+        let mut albedo = [0.0; 3];
+        let mut sigma_t = [0.0; 3];
+        for c in 0..3 {
+            check_distance("sigma_a", sigma_a[c])?;
+            check_distance("sigma_s_prime", sigma_s_prime[c])?;
+            sigma_t[c] = sigma_a[c] as f64 + sigma_s_prime[c] as f64;
+            albedo[c] = sigma_s_prime[c] as f64 / sigma_t[c];
         }
-        Ok(Self::from_channels(
-            ch.map(|d| d.expect("filled above")),
-            eta,
-        ))
+        if let ProfileModel::Burley(_) = model {
+            albedo = albedo.map(|a| better_dipole::total_reflectance(a, eta as f64));
+        }
+        Self::from_albedo_and_extinction_with(model, albedo, sigma_t, eta)
     }
 
     /// From artist parameters (JB02 §4 reparameterisation, `docs/physics.md` §4): the total
     /// diffuse reflectance K_d per channel (in (0, 1), clamped to [`KD_MIN`, `KD_MAX`]) and a
-    /// distance. α′ = Rd_total⁻¹(K_d); then σ_t′ = 1/ℓ_u, or σ_t′ = σ_tr/√(3(1−α′)) with
-    /// σ_tr = 1/ℓ_d.
+    /// distance, for the classical dipole. α′ = Rd_total⁻¹(K_d); then σ_t′ = 1/ℓ_u, or
+    /// σ_t′ = σ_tr/√(3(1−α′)) with σ_tr = 1/ℓ_d.
     pub fn from_reflectance(kd: Vec3, distance: Distance, eta: f32) -> Result<Self, ParamError> {
+        Self::from_reflectance_with(ProfileModel::Dipole, kd, distance, eta)
+    }
+
+    /// [`Profile::from_reflectance`] under any model: the model's albedo parameter whose total
+    /// reflectance is K_d (for Burley, A = K_d), and ℓ_u from the distance.
+    pub fn from_reflectance_with(
+        model: ProfileModel,
+        kd: Vec3,
+        distance: Distance,
+        eta: f32,
+    ) -> Result<Self, ParamError> {
         dipole::check_eta(eta)?;
-        let mut ch = [None; 3];
-        for (c, slot) in ch.iter_mut().enumerate() {
+        let mut albedo = [0.0; 3];
+        let mut sigma_t = [0.0; 3];
+        for c in 0..3 {
             let kd = check_kd(kd[c])? as f64;
-            let albedo = dipole::albedo_from_total_reflectance(kd, eta as f64);
-            let sigma_t = match distance {
+            albedo[c] = model.albedo_from_total_reflectance(kd, eta as f64);
+            sigma_t[c] = match distance {
                 Distance::MeanFreePath(l) => {
                     check_distance("mean_free_path", l[c])?;
                     1.0 / l[c] as f64
@@ -114,89 +238,158 @@ impl Profile {
                 Distance::DiffuseMeanFreePath(l) => {
                     check_distance("diffuse_mean_free_path", l[c])?;
                     let sigma_tr = 1.0 / l[c] as f64;
-                    sigma_tr / math::sqrt64(3.0 * (1.0 - albedo))
+                    let dipole_albedo = if model == ProfileModel::Dipole {
+                        albedo[c]
+                    } else {
+                        dipole::albedo_from_total_reflectance(kd, eta as f64)
+                    };
+                    sigma_tr / math::sqrt64(3.0 * (1.0 - dipole_albedo))
                 }
             };
-            *slot = Some(Dipole::from_albedo_and_extinction(albedo, sigma_t, eta)?);
         }
-        Ok(Self::from_channels(
-            ch.map(|d| d.expect("filled above")),
-            eta,
-        ))
+        Self::from_albedo_and_extinction_with(model, albedo, sigma_t, eta)
     }
 
     /// From the reduced albedo α′ (in (0, 1]) and reduced extinction σ_t′ = 1/ℓ_u (per scene
-    /// unit) per channel, and η: the form texture-mapped parameters arrive in (see
-    /// [`crate::dipole::AlbedoInverter`]).
+    /// unit) per channel, and η, for the classical dipole: the form texture-mapped parameters
+    /// arrive in (see [`crate::dipole::AlbedoInverter`]).
     pub fn from_albedo_and_extinction(
         albedo: [f64; 3],
         sigma_t: [f64; 3],
         eta: f32,
     ) -> Result<Self, ParamError> {
-        let mut ch = [None; 3];
-        for (c, slot) in ch.iter_mut().enumerate() {
-            *slot = Some(Dipole::from_albedo_and_extinction(
-                albedo[c], sigma_t[c], eta,
-            )?);
-        }
-        Ok(Self::from_channels(
-            ch.map(|d| d.expect("filled above")),
-            eta,
-        ))
+        Self::from_albedo_and_extinction_with(ProfileModel::Dipole, albedo, sigma_t, eta)
+    }
+
+    /// From the model's albedo parameter (α′ for the dipoles, A for Burley) and σ_t′ = 1/ℓ_u
+    /// per channel, and η.
+    pub fn from_albedo_and_extinction_with(
+        model: ProfileModel,
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+        eta: f32,
+    ) -> Result<Self, ParamError> {
+        dipole::check_eta(eta)?;
+        let channels = match model {
+            ProfileModel::Dipole => Channels::Dipole(try_channels(|c| {
+                Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], eta)
+            })?),
+            ProfileModel::BetterDipole => {
+                let boundary = Boundary::new(eta as f64);
+                Channels::BetterDipole(
+                    try_channels(|c| {
+                        BetterDipole::with_boundary(albedo[c], sigma_t[c], &boundary)
+                    })?,
+                    boundary,
+                )
+            }
+            ProfileModel::Burley(fit) => Channels::Burley(
+                try_channels(|c| {
+                    check_extinction(sigma_t[c])?;
+                    Burley::new(albedo[c], 1.0 / sigma_t[c], fit)
+                })?,
+                fit,
+            ),
+        };
+        Ok(Self::from_channels(channels, eta))
     }
 
     /// From a measured material of J01 (see [`crate::presets`]) and the number of millimetres
     /// per scene unit (the table is per mm; a scene modelled in centimetres passes 10).
     pub fn from_preset(preset: &Preset, mm_per_unit: f32) -> Result<Self, ParamError> {
+        Self::from_preset_with(ProfileModel::Dipole, preset, mm_per_unit)
+    }
+
+    /// [`Profile::from_preset`] under any model ([`Profile::from_coefficients_with`]).
+    pub fn from_preset_with(
+        model: ProfileModel,
+        preset: &Preset,
+        mm_per_unit: f32,
+    ) -> Result<Self, ParamError> {
         check_distance("mm_per_unit", mm_per_unit)?;
         let s = Vec3::splat(mm_per_unit);
-        Self::from_coefficients(
+        Self::from_coefficients_with(
+            model,
             Vec3::from(preset.sigma_a) * s,
             Vec3::from(preset.sigma_s_prime) * s,
             preset.eta,
         )
     }
 
-    /// The same material (same α′ and η per channel) with a different mean free path ℓ_u per
-    /// channel: how a texture-mapped ℓ_u is applied at a shading point. Cheap (no inversion).
+    /// The same material (same albedo parameter and η per channel) with a different mean free
+    /// path ℓ_u per channel: how a texture-mapped ℓ_u is applied at a shading point. Cheap (no
+    /// inversion).
     pub fn with_mean_free_path(&self, ell_u: Vec3) -> Result<Self, ParamError> {
-        let mut ch = self.channels;
-        for (c, d) in ch.iter_mut().enumerate() {
+        for c in 0..3 {
             check_distance("mean_free_path", ell_u[c])?;
-            *d = Dipole::from_albedo_and_extinction(d.albedo(), 1.0 / ell_u[c] as f64, self.eta)?;
         }
-        Ok(Profile {
-            channels: ch,
-            ..*self
-        })
+        let albedo = self.albedo_parameters();
+        self.with_albedo_and_extinction(albedo, ell_u.to_array().map(|l| 1.0 / l as f64))
     }
 
-    /// The same η with new α′ and σ_t′ per channel: a texture-mapped material at one shading
-    /// point. Cheaper than [`Profile::from_albedo_and_extinction`] (keeps the Fresnel
-    /// normalisation computed for this η).
+    /// The same model and η with new albedo parameters and σ_t′ per channel: a texture-mapped
+    /// material at one shading point. Cheaper than [`Profile::from_albedo_and_extinction_with`]
+    /// (keeps the η-only terms computed for this profile).
     pub fn with_albedo_and_extinction(
         &self,
         albedo: [f64; 3],
         sigma_t: [f64; 3],
     ) -> Result<Self, ParamError> {
-        let mut ch = self.channels;
-        for (c, d) in ch.iter_mut().enumerate() {
-            // A constant K_d (only ℓ textured) keeps α′: reuse its Rd_total.
-            *d = if albedo[c] == d.albedo() {
-                d.with_extinction(sigma_t[c], self.eta)?
-            } else {
-                Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], self.eta)?
-            };
-        }
-        Ok(Profile {
-            channels: ch,
-            ..*self
-        })
+        let channels = match &self.channels {
+            Channels::Dipole(ch) => Channels::Dipole(try_channels(|c| {
+                // A constant K_d (only ℓ textured) keeps α′: reuse its Rd_total.
+                if albedo[c] == ch[c].albedo() {
+                    ch[c].with_extinction(sigma_t[c], self.eta)
+                } else {
+                    Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], self.eta)
+                }
+            })?),
+            Channels::BetterDipole(_, boundary) => Channels::BetterDipole(
+                try_channels(|c| BetterDipole::with_boundary(albedo[c], sigma_t[c], boundary))?,
+                *boundary,
+            ),
+            Channels::Burley(_, fit) => Channels::Burley(
+                try_channels(|c| {
+                    check_extinction(sigma_t[c])?;
+                    Burley::new(albedo[c], 1.0 / sigma_t[c], *fit)
+                })?,
+                *fit,
+            ),
+        };
+        Ok(Profile { channels, ..*self })
     }
 
-    /// The channel dipoles (R, G, B).
-    pub fn channels(&self) -> &[Dipole; 3] {
-        &self.channels
+    /// The profile as a query on a cache of mean sample area `mean_area` evaluates it: for
+    /// Burley, whose R diverges at r = 0, point values capped at the disc average over the
+    /// mean sample's disc ([`Burley::with_near_cap`]); the dipoles are returned unchanged.
+    pub fn for_sample_area(&self, mean_area: f32) -> Self {
+        match &self.channels {
+            Channels::Burley(ch, fit) => Profile {
+                channels: Channels::Burley(ch.map(|b| b.with_near_cap(mean_area)), *fit),
+                ..*self
+            },
+            _ => *self,
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> ProfileModel {
+        match &self.channels {
+            Channels::Dipole(_) => ProfileModel::Dipole,
+            Channels::BetterDipole(..) => ProfileModel::BetterDipole,
+            Channels::Burley(_, fit) => ProfileModel::Burley(*fit),
+        }
+    }
+    /// The classical dipole's channels, if this is one.
+    pub fn dipoles(&self) -> Option<&[Dipole; 3]> {
+        match &self.channels {
+            Channels::Dipole(ch) => Some(ch),
+            _ => None,
+        }
+    }
+    /// The unitless shape of channel `c` (ℓ_u = 1, double precision): for quadratures.
+    pub fn unit_shape(&self, c: usize) -> UnitProfile {
+        UnitProfile::new(self.model(), self.albedo_parameters()[c], self.eta as f64)
     }
     /// Relative index of refraction.
     pub fn eta(&self) -> f32 {
@@ -205,60 +398,94 @@ impl Profile {
     /// Rd(r) per channel from r².
     #[inline]
     pub fn rd(&self, r2: f32) -> Vec3 {
-        Vec3::new(
-            self.channels[0].rd(r2),
-            self.channels[1].rd(r2),
-            self.channels[2].rd(r2),
-        )
+        each_model!(self, c => Vec3::new(c[0].rd(r2), c[1].rd(r2), c[2].rd(r2)))
     }
     /// Rd on eight squared distances, per channel.
     #[inline(always)]
     #[doc(hidden)]
     pub fn rd_lanes<L: Lanes>(&self, r2: L) -> [L; 3] {
-        [
-            self.channels[0].rd_lanes(r2),
-            self.channels[1].rd_lanes(r2),
-            self.channels[2].rd_lanes(r2),
-        ]
+        match &self.channels {
+            Channels::Dipole(c) => [c[0].rd_lanes(r2), c[1].rd_lanes(r2), c[2].rd_lanes(r2)],
+            Channels::BetterDipole(c, _) => better_dipole_lanes(c, r2),
+            Channels::Burley(c, _) => burley_lanes(c, r2),
+        }
     }
     /// Fourth-order corrected node aggregate per channel (see
     /// [`Dipole::rd_lanes_corrected`]).
     #[inline(always)]
     #[doc(hidden)]
     pub fn rd_lanes_corrected<L: Lanes>(&self, r2: L, m: &NodeMoments<L>) -> [L; 3] {
-        [
-            self.channels[0].rd_lanes_corrected(r2, m),
-            self.channels[1].rd_lanes_corrected(r2, m),
-            self.channels[2].rd_lanes_corrected(r2, m),
-        ]
+        match &self.channels {
+            Channels::Dipole(c) => [
+                c[0].rd_lanes_corrected(r2, m),
+                c[1].rd_lanes_corrected(r2, m),
+                c[2].rd_lanes_corrected(r2, m),
+            ],
+            Channels::BetterDipole(c, _) => better_dipole_lanes_corrected(c, r2, m),
+            Channels::Burley(c, _) => burley_lanes_corrected(c, r2, m),
+        }
     }
-    /// Rd(0) per channel.
+    /// Rd(0) per channel: N10's weight for the shading point itself (for Burley, the cap of
+    /// [`Profile::for_sample_area`]).
     pub fn rd_zero(&self) -> Vec3 {
-        Vec3::from(self.channels.map(|d| d.rd_zero()))
+        each_model!(self, c => Vec3::from(c.map(|d| d.rd_zero())))
     }
-    /// Rd_total(α′) per channel: the albedo of a flat, uniformly lit surface.
+    /// Rd_total per channel: the albedo of a flat, uniformly lit surface.
     pub fn total_reflectance(&self) -> Vec3 {
-        Vec3::from(self.channels.map(|d| d.total_reflectance()))
+        each_model!(self, c => Vec3::from(c.map(|d| d.total_reflectance())))
     }
-    /// Reduced albedo α′ per channel.
+    /// The model's albedo parameter per channel: α′ for the dipoles, A for Burley.
+    pub fn albedo_parameters(&self) -> [f64; 3] {
+        each_model!(self, c => c.map(|d| d.albedo()))
+    }
+    /// The albedo parameter per channel in single precision (α′ for the dipoles, A for Burley).
     pub fn albedo(&self) -> Vec3 {
-        Vec3::from(self.channels.map(|d| d.albedo() as f32))
+        Vec3::from(self.albedo_parameters().map(|a| a as f32))
     }
     /// Mean free path ℓ_u = 1/σ_t′ per channel.
     pub fn mean_free_path(&self) -> Vec3 {
-        Vec3::from(self.channels.map(|d| d.mean_free_path()))
+        each_model!(self, c => Vec3::from(c.map(|d| d.mean_free_path())))
     }
-    /// Diffuse mean free path ℓ_d = 1/σ_tr per channel.
+    /// The slowest exponential decay rate of R per channel (σ_tr for the dipoles, 1/(3d) for
+    /// Burley): beyond a few times its reciprocal a cluster's contribution can be bounded.
+    pub fn decay_rate(&self) -> Vec3 {
+        each_model!(self, c => Vec3::from(c.map(|d| d.decay_rate())))
+    }
+    /// The decay length 1/[`Profile::decay_rate`] per channel: the diffuse mean free path
+    /// ℓ_d = 1/σ_tr for the dipoles, 3d for Burley.
     pub fn diffuse_mean_free_path(&self) -> Vec3 {
-        Vec3::from(self.channels.map(|d| d.diffuse_mean_free_path()))
+        Vec3::ONE / self.decay_rate()
     }
-    /// Absorption σ_a per channel.
+    /// Absorption σ_a per channel: (1 − α′)/ℓ_u for the dipoles; for Burley, of the classical
+    /// dipole with the same total reflectance and ℓ_u.
     pub fn sigma_a(&self) -> Vec3 {
-        Vec3::from(self.channels.map(|d| d.sigma_a()))
+        let albedo = self.dipole_albedo();
+        let ell = self.mean_free_path();
+        Vec3::new(
+            ((1.0 - albedo[0]) / ell.x as f64) as f32,
+            ((1.0 - albedo[1]) / ell.y as f64) as f32,
+            ((1.0 - albedo[2]) / ell.z as f64) as f32,
+        )
     }
-    /// Reduced scattering σ_s′ per channel.
+    /// Reduced scattering σ_s′ per channel (α′/ℓ_u; for Burley as [`Profile::sigma_a`]).
     pub fn sigma_s_prime(&self) -> Vec3 {
-        Vec3::from(self.channels.map(|d| d.sigma_s_prime()))
+        let albedo = self.dipole_albedo();
+        let ell = self.mean_free_path();
+        Vec3::new(
+            (albedo[0] / ell.x as f64) as f32,
+            (albedo[1] / ell.y as f64) as f32,
+            (albedo[2] / ell.z as f64) as f32,
+        )
+    }
+    /// α′ of the dipoles; for Burley, of the classical dipole with its total reflectance.
+    fn dipole_albedo(&self) -> [f64; 3] {
+        match &self.channels {
+            Channels::Burley(ch, _) => ch.map(|b| {
+                let kd = b.albedo().clamp(KD_MIN as f64, KD_MAX as f64);
+                dipole::albedo_from_total_reflectance(kd, self.eta as f64)
+            }),
+            _ => self.albedo_parameters(),
+        }
     }
 
     /// Outgoing radiance from radiant exitance M_o, the project's convention
@@ -273,6 +500,53 @@ impl Profile {
     pub fn radiance_scale(&self) -> f32 {
         self.radiance_scale
     }
+}
+
+fn check_extinction(sigma_t: f64) -> Result<(), ParamError> {
+    if sigma_t.is_finite() && sigma_t > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::NotPositive {
+            name: "sigma_t",
+            value: sigma_t as f32,
+        })
+    }
+}
+
+// The models other than the classical dipole are evaluated out of line: inlined at every call
+// site of the traversal (three per mode, and the AVX2 build inlines all modes into one
+// function) they tripled its machine code and compile time for a model most scenes do not use.
+
+#[inline(never)]
+fn better_dipole_lanes<L: Lanes>(c: &[BetterDipole; 3], r2: L) -> [L; 3] {
+    [c[0].rd_lanes(r2), c[1].rd_lanes(r2), c[2].rd_lanes(r2)]
+}
+
+#[inline(never)]
+fn better_dipole_lanes_corrected<L: Lanes>(
+    c: &[BetterDipole; 3],
+    r2: L,
+    m: &NodeMoments<L>,
+) -> [L; 3] {
+    [
+        c[0].rd_lanes_corrected(r2, m),
+        c[1].rd_lanes_corrected(r2, m),
+        c[2].rd_lanes_corrected(r2, m),
+    ]
+}
+
+#[inline(never)]
+fn burley_lanes<L: Lanes>(c: &[Burley; 3], r2: L) -> [L; 3] {
+    [c[0].rd_lanes(r2), c[1].rd_lanes(r2), c[2].rd_lanes(r2)]
+}
+
+#[inline(never)]
+fn burley_lanes_corrected<L: Lanes>(c: &[Burley; 3], r2: L, m: &NodeMoments<L>) -> [L; 3] {
+    [
+        c[0].rd_lanes_corrected(r2, m),
+        c[1].rd_lanes_corrected(r2, m),
+        c[2].rd_lanes_corrected(r2, m),
+    ]
 }
 
 #[cfg(test)]

@@ -22,6 +22,8 @@ use crate::lanes::{DefaultLanes, Lanes};
 use crate::local_term::LocalTerm;
 use crate::profile::Profile;
 use crate::refine::{EDGE_THRESHOLD, uniform_within};
+#[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
+use crate::stats::QueryStats;
 use crate::stats::{NoStats, StatsSink};
 
 /// How a query sums the cache.
@@ -287,19 +289,24 @@ impl IrradianceCache {
     /// `unsafe`, and sound only on a CPU with AVX2 (check with
     /// `std::is_x86_feature_detected!("avx2")`, once). The `lucent` renderer does this in one
     /// place, `raster/src/render/simd.rs`.
+    ///
+    /// Not generic (the counts go to a [`QueryStats`]; [`StatsSink::merge`] passes them on):
+    /// the whole traversal, inlined, is about 400 kB of machine code, so it is compiled once,
+    /// here, instead of once per statistics type in every crate that calls it.
     #[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
     #[target_feature(enable = "avx2")]
-    pub fn query_planned_avx2<S: StatsSink>(
+    #[inline(never)]
+    pub fn query_planned_avx2(
         &self,
         plan: &QueryPlan,
         point: &ShadingPoint,
-        stats: &mut S,
+        stats: &mut QueryStats,
     ) -> Result<Exitance, QueryError> {
         stats.query();
         check_point(point)?;
         // `ArrayLanes` inlines the whole traversal here (`Lanes::INLINE_TRAVERSAL`), so that all
         // of it is compiled for AVX2.
-        Ok(self.run::<crate::lanes::ArrayLanes, S>(plan, point, stats))
+        Ok(self.run::<crate::lanes::ArrayLanes, QueryStats>(plan, point, stats))
     }
 
     /// [`IrradianceCache::query_with_stats`] with an explicit lane type (SIMD or scalar): for
@@ -345,6 +352,7 @@ impl IrradianceCache {
             return Err(QueryError::InvalidLocalIntegral);
         }
         settings.validate()?;
+        let profile = &profile.for_sample_area(self.mean_area());
         // N10's sums are scaled by powers of two near 1/Rd(0) and 1/Ā (see `Params`).
         let rd_zero = profile.rd_zero().to_array();
         let rd_scale = rd_zero.map(reciprocal_pow2);

@@ -384,7 +384,7 @@ mod tests {
         for alpha in [0.02_f32, 0.1, 0.5] {
             let q = LocalQuadrature::new(&p, alpha, 8, 1);
             for c in 0..3 {
-                let d = &p.channels()[c];
+                let d = &p.dipoles().unwrap()[c];
                 let dip = UnitDipole::new(d.albedo(), f64::from(p.eta()));
                 let ell = f64::from(d.mean_free_path());
                 let a = f64::from(alpha);
@@ -425,7 +425,7 @@ mod tests {
         let p = marble(20.0);
         let alpha = 0.1_f32;
         let q = LocalQuadrature::new(&p, alpha, DEFAULT_RINGS, DEFAULT_PER_RING);
-        let d0 = &p.channels()[1];
+        let d0 = &p.dipoles().unwrap()[1];
         let dip = UnitDipole::new(d0.albedo(), f64::from(p.eta()));
         let ell = f64::from(d0.mean_free_path());
         let a = f64::from(alpha);

@@ -19,13 +19,32 @@ pub trait StatsSink {
     /// `n` subtrees were skipped as negligible.
     #[inline(always)]
     fn culled(&mut self, _n: u32) {}
+    /// The events another sink counted, passed on: how a query that counts into a
+    /// [`QueryStats`] (the AVX2 traversal, compiled once for that type) reports to any sink.
+    /// The default replays them one by one; sinks that count override it.
+    #[inline]
+    fn merge(&mut self, counts: &QueryStats) {
+        for _ in 0..counts.queries {
+            self.query();
+        }
+        for _ in 0..counts.nodes_opened {
+            self.node();
+        }
+        let saturate = |n: u64| u32::try_from(n).unwrap_or(u32::MAX);
+        self.aggregates(saturate(counts.aggregates));
+        self.samples(saturate(counts.samples));
+        self.culled(saturate(counts.culled));
+    }
 }
 
 /// Discards every event.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoStats;
 
-impl StatsSink for NoStats {}
+impl StatsSink for NoStats {
+    #[inline(always)]
+    fn merge(&mut self, _counts: &QueryStats) {}
+}
 
 /// Counts traversal events (accumulates over any number of queries).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -69,5 +88,13 @@ impl StatsSink for QueryStats {
     #[inline(always)]
     fn culled(&mut self, n: u32) {
         self.culled += n as u64;
+    }
+    #[inline]
+    fn merge(&mut self, counts: &QueryStats) {
+        self.queries += counts.queries;
+        self.nodes_opened += counts.nodes_opened;
+        self.aggregates += counts.aggregates;
+        self.samples += counts.samples;
+        self.culled += counts.culled;
     }
 }

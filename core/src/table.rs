@@ -68,13 +68,13 @@ use core::sync::atomic::{AtomicU64, Ordering};
 
 use glam::Vec3;
 
-use crate::dipole::UnitDipole;
 use crate::error::ParamError;
 use crate::kernel::Kernel;
 use crate::local_term::LocalTerm;
 use crate::math;
 use crate::profile::Profile;
 use crate::quadrature::GaussLegendre;
+use crate::unit_profile::{UnitProfile, UnitShape};
 
 /// Bits of an entry that has not been computed (quiet NaNs no quadrature produces).
 const EMPTY: u64 = 0x7fc0_dead_7fc0_dead;
@@ -84,8 +84,8 @@ const K_MAX: i32 = 127;
 /// The integral K(α/ℓ_u) = 2π ∫₀^a w(ρ/a) Rd_1(ρ) ρ dρ for one channel, by composite
 /// 32-point Gauss–Legendre over geometrically growing intervals (the integrand varies on the
 /// scale of ℓ near 0 and decays like e^(−σ_tr ρ)); relative accuracy about 1e-12.
-pub fn local_integral_unit(dipole: &UnitDipole, a: f64) -> f64 {
-    local_integral_and_slope_unit(dipole, a).0
+pub fn local_integral_unit<U: UnitShape + ?Sized>(shape: &U, a: f64) -> f64 {
+    local_integral_and_slope_unit(shape, a).0
 }
 
 /// a·dK/da, K's derivative in a = α/ℓ_u, by differentiating under the integral:
@@ -96,20 +96,20 @@ pub fn local_integral_unit(dipole: &UnitDipole, a: f64) -> f64 {
 ///
 /// (no boundary term: w(1) = 0). It is ≥ 0 (K grows with a, i.e. falls with ℓ), and
 /// d ln K / d ln ℓ = −a·(dK/da)/K. Same quadrature as [`local_integral_unit`].
-pub fn local_integral_slope_unit(dipole: &UnitDipole, a: f64) -> f64 {
-    local_integral_and_slope_unit(dipole, a).1
+pub fn local_integral_slope_unit<U: UnitShape + ?Sized>(shape: &U, a: f64) -> f64 {
+    local_integral_and_slope_unit(shape, a).1
 }
 
 /// (K, a·dK/da) in one pass of the composite rule of [`local_integral_unit`]: the two
 /// integrands share Rd_1(ρ), which is most of the cost. K is the same bits whether or not the
 /// slope is wanted (the table's nodes must equal [`local_integral_unit`] exactly).
-pub fn local_integral_and_slope_unit(dipole: &UnitDipole, a: f64) -> (f64, f64) {
+pub fn local_integral_and_slope_unit<U: UnitShape + ?Sized>(shape: &U, a: f64) -> (f64, f64) {
     if !(a > 0.0) {
         return (0.0, 0.0);
     }
     let rule = GaussLegendre::<32>::new();
     let f = |rho: f64| {
-        let common = 2.0 * core::f64::consts::PI * rho * dipole.rd(rho);
+        let common = shape.ring_density(rho);
         let u = rho / a;
         (
             common * Kernel::weight_unit(u),
@@ -117,7 +117,7 @@ pub fn local_integral_and_slope_unit(dipole: &UnitDipole, a: f64) -> (f64, f64) 
         )
     };
     // Beyond ρ_end the profile has decayed below e^(−60) of its peak region.
-    let end = a.min(60.0 / dipole.sigma_tr().max(1e-300) + 60.0);
+    let end = a.min(60.0 / shape.decay_rate().max(1e-300) + 60.0);
     let mut total = (0.0, 0.0);
     let mut lo = 0.0;
     let mut hi = end.min(0.125);
@@ -137,19 +137,19 @@ pub fn local_integral_and_slope_unit(dipole: &UnitDipole, a: f64) -> (f64, f64) 
 /// K per channel for `profile` (at its own ℓ_u) and smoothing radius `alpha`, by a fresh
 /// quadrature: what the table approximates, for measuring it.
 pub fn exact_local_integral(profile: &Profile, alpha: f32) -> Vec3 {
-    let eta = profile.eta() as f64;
-    Vec3::from(profile.channels().map(|d| {
-        local_integral_unit(
-            &UnitDipole::new(d.albedo(), eta),
-            alpha as f64 / d.mean_free_path() as f64,
-        ) as f32
+    let ell = profile.mean_free_path();
+    Vec3::from(core::array::from_fn::<f32, 3, _>(|c| {
+        profile
+            .unit_shape(c)
+            .local_integral_and_slope(alpha as f64 / ell[c] as f64)
+            .0 as f32
     }))
 }
 
 /// One channel's constants.
 #[derive(Clone, Copy, Debug)]
 struct Channel {
-    unit: UnitDipole,
+    unit: UnitProfile,
     limit: f32,
 }
 
@@ -282,10 +282,10 @@ impl LocalIntegralTable {
                 value: ell_min,
             });
         }
-        let eta = profile.eta() as f64;
-        let channels = profile.channels().map(|d| Channel {
-            unit: UnitDipole::new(d.albedo(), eta),
-            limit: d.total_reflectance(),
+        let limit = profile.total_reflectance();
+        let channels = core::array::from_fn(|c| Channel {
+            unit: profile.unit_shape(c),
+            limit: limit[c],
         });
         // Smallest power of two strictly above ℓ_min/α (2^−126 if that is 0 or subnormal).
         let ratio_min = ell_min / alpha;
@@ -347,7 +347,10 @@ impl LocalIntegralTable {
     }
 
     fn exact_channel(&self, c: usize, ell: f32) -> f32 {
-        local_integral_unit(&self.channels[c].unit, self.alpha as f64 / ell as f64) as f32
+        self.channels[c]
+            .unit
+            .local_integral_and_slope(self.alpha as f64 / ell as f64)
+            .0 as f32
     }
 
     /// The cached segment from node k to k + 1 for channel c, computing it on first use. It
@@ -377,7 +380,7 @@ impl LocalIntegralTable {
     fn fill(&self, slots: &[AtomicU64; 2], c: usize, k: i32) -> Segment {
         let unit = &self.channels[c].unit;
         let node = |k: i32| {
-            let (v, a_dk_da) = local_integral_and_slope_unit(unit, math::pow2i64(-k));
+            let (v, a_dk_da) = unit.local_integral_and_slope(math::pow2i64(-k));
             // d ln K / d log₂ ℓ = −ln 2 · a·(dK/da) / K.
             let slope = if v > 0.0 {
                 -core::f64::consts::LN_2 * a_dk_da / v
@@ -515,6 +518,7 @@ mod tests {
     extern crate std;
 
     use super::*;
+    use crate::dipole::UnitDipole;
     use crate::profile::Distance;
 
     fn profile(kd: f32, eta: f32) -> Profile {
@@ -617,7 +621,7 @@ mod tests {
         ] {
             let got = table.exact_or_limit(ell);
             for c in 0..3 {
-                let d = UnitDipole::new(p.channels()[c].albedo(), 1.4);
+                let d = UnitDipole::new(p.dipoles().unwrap()[c].albedo(), 1.4);
                 let want = local_integral_unit(&d, alpha as f64 / ell[c] as f64);
                 assert!(
                     ((got[c] as f64 - want) / want).abs() <= f32::EPSILON as f64 / 2.0,

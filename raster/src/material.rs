@@ -166,7 +166,7 @@ pub(crate) fn reflectance_params(
     let base = Profile::from_reflectance(representative_kd, make(lo), eta)?;
     Profile::from_reflectance(representative_kd, make(hi), eta)?;
     let kd = match kd {
-        ColorParam::Constant(_) => KdSource::Constant(base.channels().map(|d| d.albedo())),
+        ColorParam::Constant(_) => KdSource::Constant(base.albedo_parameters()),
         ColorParam::Texture(t) => {
             // Both ends of the reflectance range must make valid profiles too.
             for v in [0.001, 0.999] {

@@ -16,6 +16,8 @@ pub fn exhaustive_sum(cache: &IrradianceCache, profile: &Profile, x: Vec3) -> Ve
 
 /// [`exhaustive_sum`] with an explicit lane type.
 pub fn exhaustive_sum_lanes<L: Lanes>(cache: &IrradianceCache, profile: &Profile, x: Vec3) -> Vec3 {
+    // As a query evaluates it (Burley's near-field cap; the dipoles unchanged).
+    let profile = &profile.for_sample_area(cache.mean_area());
     let s = &cache.samples;
     let (xx, xy, xz) = (L::splat(x.x), L::splat(x.y), L::splat(x.z));
     let mut total = DVec3::ZERO;
@@ -35,6 +37,7 @@ pub fn exhaustive_sum_lanes<L: Lanes>(cache: &IrradianceCache, profile: &Profile
 /// The split sums over every sample in double precision: (Σ (1 − w) Rd E A, Σ w Rd E A,
 /// Σ w Rd A) for the kernel of radius α ([`crate::kernel`]).
 fn split_sums(cache: &IrradianceCache, profile: &Profile, x: Vec3, alpha: f32) -> [DVec3; 3] {
+    let profile = &profile.for_sample_area(cache.mean_area());
     let kernel = Kernel::new(alpha);
     let s = &cache.samples;
     let mut sums = [DVec3::ZERO; 3];
@@ -76,7 +79,11 @@ pub fn exhaustive_edge_aware(
     alpha: f32,
 ) -> Vec3 {
     let [global, num, den] = split_sums(cache, profile, x, alpha);
-    let centre = profile.rd_zero().as_dvec3() * cache.mean_area() as f64;
+    let centre = profile
+        .for_sample_area(cache.mean_area())
+        .rd_zero()
+        .as_dvec3()
+        * cache.mean_area() as f64;
     let e_loc = (centre * irradiance.as_dvec3() + num) / (centre + den);
     let e_loc = DVec3::select(e_loc.is_finite_mask(), e_loc, irradiance.as_dvec3());
     (e_loc * local_integral.as_dvec3() + global).as_vec3()

@@ -498,12 +498,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         let tolerance = params.cull_tolerance;
         let total_area = nodes.area[0].max(f32::MIN_POSITIVE);
         // Culling is only attempted beyond two diffusion lengths of the slowest channel.
-        let sigma_tr_min = self
-            .profile
-            .channels()
-            .iter()
-            .map(|d| d.sigma_tr())
-            .fold(f32::INFINITY, f32::min);
+        let sigma_tr_min = self.profile.decay_rate().min_element();
         let cull_from = 2.0 / sigma_tr_min;
         let cull_from2 = L::splat(cull_from * cull_from);
         let [xx, xy, xz] = self.x;

@@ -9,6 +9,7 @@ mod common;
 mod cache_build;
 mod edge_refined;
 mod plane_bias;
+mod profiles;
 mod queries;
 mod stress;
 mod uniform_plane;

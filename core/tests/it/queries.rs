@@ -207,59 +207,6 @@ fn simd_and_scalar_lanes_agree() {
     }
 }
 
-/// The lane type of the AVX2 traversal gives the bits of the default SIMD lanes on every
-/// method, at several ε and cull tolerances, on shadowed and random sample sets and points on
-/// and off the surface, and takes the same steps. (Compiled here for the crate's target
-/// features: the renderer's `render::simd` tests run it compiled for AVX2.)
-#[cfg(feature = "simd")]
-#[test]
-fn array_and_simd_lanes_agree_bit_for_bit() {
-    use lucent_core::internals::{ArrayLanes, SimdLanes};
-    let bits = |e: &lucent_core::Exitance| {
-        [e.total, e.local, e.global, e.local_irradiance].map(|v| v.to_array().map(f32::to_bits))
-    };
-    let mut rng = Rng(21);
-    let sets = [
-        sphere_samples(3000, 1.0, 22),
-        box_samples(2000, 0.5, 23),
-        sphere_samples(300, 0.01, 24),
-    ];
-    for samples in &sets {
-        let cache = IrradianceCache::build(samples).unwrap();
-        let scale = samples[0].position.length().max(0.5);
-        let p = profile(0.05 * scale);
-        let alpha = cache.smoothing_radius(2.0);
-        for x in query_points(60, rng.next_u64()) {
-            let x = x * scale;
-            let k = rng.vec3(0.0, 1.0);
-            let e = Vec3::new(rng.range(0.0, 2.0), 0.0, rng.range(0.0, 1.0));
-            let at = ShadingPoint {
-                position: x,
-                irradiance: e,
-            };
-            for method in Method::ALL {
-                for (eps, cull) in [(0.05, 1e-4), (0.5, 0.0), (0.0, 0.0), (2.0, 1e-2)] {
-                    let s = settings(method, eps, cull);
-                    let (mut sa, mut sb) = (QueryStats::default(), QueryStats::default());
-                    let a = cache
-                        .query_with::<SimdLanes, _>(&p, &at, term(alpha, k), &s, &mut sa)
-                        .unwrap();
-                    let b = cache
-                        .query_with::<ArrayLanes, _>(&p, &at, term(alpha, k), &s, &mut sb)
-                        .unwrap();
-                    assert_eq!(
-                        bits(&a),
-                        bits(&b),
-                        "{method:?} ε {eps} at {x}: {a:?} vs {b:?}"
-                    );
-                    assert_eq!(a.refine, b.refine);
-                    assert_eq!(sa, sb, "{method:?} ε {eps} at {x}");
-                }
-            }
-        }
-    }
-}
-
 #[test]
 fn queries_are_deterministic_across_threads() {
     let cache = IrradianceCache::build(&sphere_samples(5000, 1.0, 9)).unwrap();

@@ -336,7 +336,7 @@ fn reflectance_and_eta_grid_round_trips() {
             );
             for c in 0..3 {
                 let a = inverter.albedo(kd[c]);
-                let exact = p.channels()[c].albedo();
+                let exact = p.albedo_parameters()[c];
                 // The inverter is accurate to ~1e-6 in K_d; in α′ that is worst near α′ = 1.
                 assert!(
                     a > 0.0 && a <= 1.0 && (a - exact).abs() < 2e-3,

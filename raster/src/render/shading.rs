@@ -191,6 +191,10 @@ impl StatsSink for ShadingCounters {
     fn culled(&mut self, n: u32) {
         self.traversal.culled(n);
     }
+    #[inline]
+    fn merge(&mut self, counts: &QueryStats) {
+        self.traversal.merge(counts);
+    }
 }
 
 impl ShadingStats for ShadingCounters {
@@ -467,7 +471,7 @@ mod tests {
     /// table's code path).
     fn quadrature_k(profile: &lucent_core::Profile, alpha: f32) -> Vec3 {
         let eta = f64::from(profile.eta());
-        Vec3::from(profile.channels().map(|d| {
+        Vec3::from(profile.dipoles().expect("a classical dipole").map(|d| {
             let a = f64::from(alpha) / f64::from(d.mean_free_path());
             local_integral_unit(&UnitDipole::new(d.albedo(), eta), a) as f32
         }))

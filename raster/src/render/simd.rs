@@ -13,7 +13,7 @@ use std::fmt;
 use std::sync::OnceLock;
 
 use lucent_core::error::QueryError;
-use lucent_core::stats::StatsSink;
+use lucent_core::stats::{QueryStats, StatsSink};
 use lucent_core::{
     Exitance, IrradianceCache, LocalTerm, Profile, QueryPlan, QuerySettings, ShadingPoint,
 };
@@ -98,11 +98,13 @@ impl Avx2 {
     ) -> Result<Exitance, QueryError> {
         #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
         {
+            let mut counts = QueryStats::default();
             // The renderer's one `unsafe` (the crate's lints deny it everywhere else).
             #[allow(unsafe_code)]
             // SAFETY: `query_planned_avx2` is compiled with AVX2 enabled and needs nothing
             // else; an `Avx2` exists only where `is_x86_feature_detected!("avx2")` found it.
-            let result = unsafe { cache.query_planned_avx2(plan, point, stats) };
+            let result = unsafe { cache.query_planned_avx2(plan, point, &mut counts) };
+            stats.merge(&counts);
             result
         }
         #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]

@@ -120,7 +120,8 @@ impl Exact {
     fn new(profile: &Profile) -> Exact {
         let rule = GaussLegendre::<16>::new();
         let channels: Vec<Channel> = profile
-            .channels()
+            .dipoles()
+            .expect("a classical dipole")
             .iter()
             .map(|d| Channel {
                 dipole: UnitDipole::new(d.albedo(), f64::from(profile.eta())),
