@@ -228,6 +228,9 @@ pub struct Tally {
     pub beyond_last: u64,
     /// Exits per bin.
     pub bins: Vec<u64>,
+    /// Exits after exactly one scattering (the single-scattering part of the total, which
+    /// has a closed form to check the boundary against).
+    pub single_scattered: u64,
     /// Scattering or absorption events.
     pub interactions: u64,
     /// Internal Fresnel reflections at the boundary.
@@ -245,6 +248,7 @@ impl Tally {
         self.beyond_last += other.beyond_last;
         self.interactions += other.interactions;
         self.internal_reflections += other.internal_reflections;
+        self.single_scattered += other.single_scattered;
         if self.bins.len() < other.bins.len() {
             self.bins.resize(other.bins.len(), 0);
         }
@@ -334,6 +338,7 @@ fn trace(
 ) -> Option<f64> {
     let inverse_eta = 1.0 / settings.eta;
     let mut p = [0.0f64; 3];
+    let mut scatterings = 0u32;
     loop {
         // Free path s ~ e^(−s); 1 − u ∈ (0, 1], so the logarithm is finite.
         let s = -math::ln64(1.0 - rng.uniform());
@@ -347,6 +352,9 @@ fn trace(
             let f = fresnel::reflectance(inverse_eta, -direction[2]);
             let reflect = f >= 1.0 || (f > 0.0 && rng.uniform() < f);
             if !reflect {
+                if scatterings == 1 {
+                    tally.single_scattered += 1;
+                }
                 return Some(math::sqrt64(p[0] * p[0] + p[1] * p[1]));
             }
             tally.internal_reflections += 1;
@@ -366,6 +374,7 @@ fn trace(
         if rng.uniform() >= settings.albedo {
             return None;
         }
+        scatterings += 1;
         direction = isotropic(rng);
     }
 }
