@@ -2,17 +2,18 @@
 //! of the core (`lucent_core::internals::random_walk`).
 //!
 //! ```text
-//! check:  η = 1, α′ ∈ {0.3, 0.8, 0.99}, both illuminations: the walk's total against
-//!         Chandrasekhar's plane / spherical albedo (the walk's own credibility)
-//! for each illumination (pencil beam, diffuse) × α′ ∈ {0.1, 0.3, 0.5, 0.7, 0.9, 0.95, 0.99}
-//!     walk   = the random walk at η = 1.3, `photons` entered photons, 20 bins per decade
+//! for each η (1.3, and 1 where the totals are exact and Burley's fits were made)
+//!   × illumination (pencil beam, diffuse) × α′ ∈ {0.1, 0.3, 0.5, 0.7, 0.9, 0.95, 0.99}:
+//!     walk   = the random walk, `photons` entered photons, 20 bins per decade
+//!     at η = 1: its total against Chandrasekhar's plane / spherical albedo (the reference's
+//!               own credibility)
 //!     per model in MODELS:
 //!         total error          (model total − walk total) / walk total
 //!         mean relative error  |R_model − R_walk| / R_walk over the bins in [0.1, 10] ℓ_u,
 //!                              the model averaged over each annulus as the walk scores it
-//! report: profiles.md, profiles.csv (one row per model × illumination × α′),
+//! report: profiles.md, profiles.csv (one row per model × η × illumination × α′),
 //!         profile-bins.csv (every bin: walk, its error, every model),
-//!         profile-<illumination>-<α′>.svg (log R against log r/ℓ_u, walk and models)
+//!         profile-eta<η>-<illumination>-<α′>.svg (log R against log r/ℓ_u, walk and models)
 //! ```
 //!
 //! A model is one entry of [`MODELS`]: a name and a function from [`ModelInput`] (α′, η, the
@@ -23,11 +24,14 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use lucent_core::BurleyFit;
 use lucent_core::internals::random_walk::{
     self as walk, COMPARE_RANGE, HFunction, Illumination, ProfileComparison, RadialProfile, Tally,
     WalkSettings,
 };
-use lucent_core::internals::{UnitDipole, total_reflectance};
+use lucent_core::internals::{
+    Boundary, UnitBetterDipole, UnitBurley, UnitDipole, total_reflectance,
+};
 use rayon::prelude::*;
 
 use super::BenchError;
@@ -65,13 +69,25 @@ pub struct ModelEntry {
     pub build: fn(&ModelInput) -> ModelCurve,
 }
 
-/// The models measured, in table order. Adding one is adding an entry: the better dipole,
-/// Burley's normalised diffusion with the searchlight fit of s and with the diffuse-
-/// transmission fit (both at A = `walk_total`) go here once the core has them.
-pub const MODELS: &[ModelEntry] = &[ModelEntry {
-    name: "classical dipole",
-    build: classical_dipole,
-}];
+/// The models measured, in table order. Adding one is adding an entry.
+pub const MODELS: &[ModelEntry] = &[
+    ModelEntry {
+        name: "classical dipole",
+        build: classical_dipole,
+    },
+    ModelEntry {
+        name: "better dipole",
+        build: better_dipole,
+    },
+    ModelEntry {
+        name: "Burley (searchlight fit)",
+        build: burley_searchlight,
+    },
+    ModelEntry {
+        name: "Burley (diffuse-transmission fit)",
+        build: burley_diffuse,
+    },
+];
 
 /// The classical dipole of Jensen et al. 2001 (`docs/physics.md` §2), with its closed-form
 /// total.
@@ -83,17 +99,46 @@ fn classical_dipole(input: &ModelInput) -> ModelCurve {
     }
 }
 
+/// d'Eon's better dipole (2012), with its closed-form total.
+fn better_dipole(input: &ModelInput) -> ModelCurve {
+    let dipole = UnitBetterDipole::new(input.albedo, &Boundary::new(input.eta));
+    ModelCurve {
+        rd: Box::new(move |r| dipole.rd(r)),
+        total: dipole.total_reflectance(),
+    }
+}
+
+/// Christensen & Burley's normalised diffusion (2015) with the surface albedo A set to the
+/// walk's measured total, as in their comparison: its total error is zero by construction,
+/// and only the shape is measured.
+fn burley(input: &ModelInput, fit: BurleyFit) -> ModelCurve {
+    let profile = UnitBurley::new(input.walk_total, fit);
+    ModelCurve {
+        rd: Box::new(move |r| profile.rd(r)),
+        total: input.walk_total,
+    }
+}
+
+/// [`burley`] with the searchlight fit of s(A) (made for a pencil beam).
+fn burley_searchlight(input: &ModelInput) -> ModelCurve {
+    burley(input, BurleyFit::Searchlight)
+}
+
+/// [`burley`] with the diffuse-transmission fit of s(A) (made for diffuse light).
+fn burley_diffuse(input: &ModelInput) -> ModelCurve {
+    burley(input, BurleyFit::DiffuseTransmission)
+}
+
 /// The run's settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ProfilesConfig {
     /// Reduced albedos.
     pub albedos: Vec<f64>,
-    /// Relative index η.
-    pub eta: f64,
-    /// Entered photons per walk (per albedo and illumination).
+    /// Relative indices η, each a section of the report. At η = 1 the walk's totals are also
+    /// checked against Chandrasekhar's exact values.
+    pub etas: Vec<f64>,
+    /// Entered photons per walk (per η, albedo and illumination).
     pub photons: u64,
-    /// Photons per walk of the η = 1 check against Chandrasekhar (0: skip it).
-    pub check_photons: u64,
     /// The walks' seed.
     pub seed: u64,
     /// Albedos drawn as profile charts (those not in `albedos` are skipped).
@@ -106,14 +151,14 @@ pub struct ProfilesConfig {
 const ALBEDOS: [f64; 7] = [0.1, 0.3, 0.5, 0.7, 0.9, 0.95, 0.99];
 
 impl ProfilesConfig {
-    /// The published measurement: 8 × 10⁶ photons per walk, η = 1.3 (about 40 s on one
-    /// core).
+    /// The published measurement: 8 × 10⁶ photons per walk, η = 1.3 (skin) and η = 1 (the
+    /// index-matched boundary, where the walk has exact totals and Burley's fits were made);
+    /// about 70 s on one core.
     pub fn full() -> Self {
         ProfilesConfig {
             albedos: ALBEDOS.to_vec(),
-            eta: 1.3,
+            etas: vec![1.3, 1.0],
             photons: 8_000_000,
-            check_photons: 2_000_000,
             seed: 1,
             plot_albedos: vec![0.5, 0.95],
             threads: None,
@@ -124,7 +169,6 @@ impl ProfilesConfig {
     pub fn quick() -> Self {
         ProfilesConfig {
             photons: 100_000,
-            check_photons: 50_000,
             ..Self::full()
         }
     }
@@ -141,7 +185,7 @@ pub struct WalkResult {
     pub models: Vec<(f64, ProfileComparison)>,
 }
 
-/// The walk's total at η = 1 against Chandrasekhar's.
+/// A walk's total at η = 1 against Chandrasekhar's.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CheckRow {
     /// Illumination.
@@ -156,14 +200,21 @@ pub struct CheckRow {
     pub exact: f64,
 }
 
+impl CheckRow {
+    /// (walk − exact) / standard error.
+    pub fn z(&self) -> f64 {
+        (self.walk - self.exact) / self.std_error
+    }
+}
+
 /// Everything `--profiles` measured.
 #[derive(Clone, Debug)]
 pub struct ProfilesReport {
     /// The settings.
     pub config: ProfilesConfig,
-    /// The η = 1 checks.
+    /// The walks at η = 1 against Chandrasekhar.
     pub checks: Vec<CheckRow>,
-    /// The walks, pencil beam first, each in albedo order.
+    /// The walks: per η, pencil beam then diffuse, each in albedo order.
     pub walks: Vec<WalkResult>,
     /// Wall time of the whole run, seconds.
     pub seconds: f64,
@@ -185,86 +236,75 @@ pub fn run(
     let pool = builder
         .build()
         .map_err(|e| BenchError::new(format!("cannot start the worker threads: {e}")))?;
-    let settings = |albedo: f64, eta: f64, illumination, photons| WalkSettings {
-        illumination,
-        photons,
-        seed: config.seed,
-        ..WalkSettings::new(albedo, eta)
-    };
-    let run_walk = |s: &WalkSettings| -> Result<RadialProfile, BenchError> {
-        s.validate().map_err(|e| BenchError::new(e.to_string()))?;
-        let tally = pool.install(|| {
-            (0..s.chunks())
-                .into_par_iter()
-                .map(|chunk| walk::walk_chunk(s, chunk))
-                .reduce(Tally::default, |mut a, b| {
-                    a.merge(&b);
-                    a
-                })
-        });
-        Ok(RadialProfile::from_tally(s, &tally))
-    };
-
+    let mut walks = Vec::new();
     let mut checks = Vec::new();
-    if config.check_photons > 0 {
+    for &eta in &config.etas {
         for illumination in ILLUMINATIONS {
-            for albedo in [0.3, 0.8, 0.99] {
-                let p = run_walk(&settings(albedo, 1.0, illumination, config.check_photons))?;
-                let h = HFunction::new(albedo);
-                let exact = match illumination {
-                    Illumination::PencilBeam => h.plane_albedo(1.0),
-                    Illumination::Diffuse => h.spherical_albedo(),
-                };
-                checks.push(CheckRow {
+            for &albedo in &config.albedos {
+                let s = WalkSettings {
                     illumination,
+                    photons: config.photons,
+                    seed: config.seed,
+                    ..WalkSettings::new(albedo, eta)
+                };
+                s.validate().map_err(|e| BenchError::new(e.to_string()))?;
+                let t = Instant::now();
+                let tally = pool.install(|| {
+                    (0..s.chunks())
+                        .into_par_iter()
+                        .map(|chunk| walk::walk_chunk(&s, chunk))
+                        .reduce(Tally::default, |mut a, b| {
+                            a.merge(&b);
+                            a
+                        })
+                });
+                let profile = RadialProfile::from_tally(&s, &tally);
+                let seconds = t.elapsed().as_secs_f64();
+                let input = ModelInput {
                     albedo,
-                    walk: p.total,
-                    std_error: p.total_std_error,
-                    exact,
+                    eta,
+                    illumination,
+                    walk_total: profile.total,
+                };
+                let models = MODELS
+                    .iter()
+                    .map(|m| {
+                        let curve = (m.build)(&input);
+                        (curve.total, walk::compare(&profile, &curve.rd, curve.total))
+                    })
+                    .collect();
+                if eta == 1.0 {
+                    let h = HFunction::new(albedo);
+                    checks.push(CheckRow {
+                        illumination,
+                        albedo,
+                        walk: profile.total,
+                        std_error: profile.total_std_error,
+                        exact: match illumination {
+                            Illumination::PencilBeam => h.plane_albedo(1.0),
+                            Illumination::Diffuse => h.spherical_albedo(),
+                        },
+                    });
+                }
+                log(&format!(
+                    "η = {eta}, {} α′ = {albedo}: total {:.5} ± {:.5} ({seconds:.1} s)",
+                    illumination.name(),
+                    profile.total,
+                    profile.total_std_error
+                ));
+                walks.push(WalkResult {
+                    profile,
+                    seconds,
+                    models,
                 });
             }
         }
-        log(&format!(
-            "η = 1 check against Chandrasekhar: largest |z| {:.2}",
-            checks
-                .iter()
-                .map(|c| ((c.walk - c.exact) / c.std_error).abs())
-                .fold(0.0, f64::max)
-        ));
     }
-
-    let mut walks = Vec::new();
-    for illumination in ILLUMINATIONS {
-        for &albedo in &config.albedos {
-            let s = settings(albedo, config.eta, illumination, config.photons);
-            let t = Instant::now();
-            let profile = run_walk(&s)?;
-            let seconds = t.elapsed().as_secs_f64();
-            let input = ModelInput {
-                albedo,
-                eta: config.eta,
-                illumination,
-                walk_total: profile.total,
-            };
-            let models = MODELS
-                .iter()
-                .map(|m| {
-                    let curve = (m.build)(&input);
-                    (curve.total, walk::compare(&profile, &curve.rd, curve.total))
-                })
-                .collect();
-            log(&format!(
-                "{} α′ = {albedo}: total {:.5} ± {:.5} ({seconds:.1} s)",
-                illumination.name(),
-                profile.total,
-                profile.total_std_error
-            ));
-            walks.push(WalkResult {
-                profile,
-                seconds,
-                models,
-            });
-        }
+    if !checks.is_empty() {
+        log(&format!(
+            "η = 1 against Chandrasekhar: largest |z| {:.2}",
+            checks.iter().map(|c| c.z().abs()).fold(0.0, f64::max)
+        ));
     }
     Ok(ProfilesReport {
         config: config.clone(),
@@ -279,29 +319,73 @@ fn percent(x: f64) -> String {
     format!("{:+.1}%", 100.0 * x)
 }
 
-/// The walks of one illumination, in albedo order.
-fn walks_of(report: &ProfilesReport, illumination: Illumination) -> Vec<&WalkResult> {
+/// The walks at one η under one illumination, in albedo order.
+fn walks_of(report: &ProfilesReport, eta: f64, illumination: Illumination) -> Vec<&WalkResult> {
     report
         .walks
         .iter()
-        .filter(|w| w.profile.settings.illumination == illumination)
+        .filter(|w| {
+            w.profile.settings.eta == eta && w.profile.settings.illumination == illumination
+        })
         .collect()
 }
 
-/// `profiles.md`: the checks, the walks' totals, and one table per model.
+/// `profiles.md`: per η the walks' totals and one table per model, then the check against
+/// Chandrasekhar.
 pub fn markdown(report: &ProfilesReport) -> String {
     let c = &report.config;
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# lucent bench --profiles\n\nAnalogue random walk in a semi-infinite medium (reduced coefficients, isotropic scattering, σ_t′ = 1), η = {}, {} entered photons per walk, seed {}; radii in ℓ_u = 1/σ_t′, 20 bins per decade. Per unit flux transmitted into the medium. Pencil beam = normal incidence; diffuse = cosine-weighted incidence refracted in. Mean relative error over the bins whose centre lies in [{}, {}] ℓ_u, each model averaged over the bin's annulus. Total run time {:.1} s.\n",
-        c.eta, c.photons, c.seed, COMPARE_RANGE.0, COMPARE_RANGE.1, report.seconds
+        "# lucent bench --profiles\n\nAnalogue random walk in a semi-infinite medium (reduced coefficients, isotropic scattering, σ_t′ = 1), {} entered photons per walk, seed {}; radii in ℓ_u = 1/σ_t′, 20 bins per decade. Per unit flux transmitted into the medium. Pencil beam = normal incidence; diffuse = cosine-weighted incidence refracted in. Mean relative error over the bins whose centre lies in [{}, {}] ℓ_u, each model averaged over the bin's annulus; Burley's A is the walk's total, so its total error is zero by construction. Total run time {:.1} s.",
+        c.photons, c.seed, COMPARE_RANGE.0, COMPARE_RANGE.1, report.seconds
     );
+    for &eta in &c.etas {
+        let pencil = walks_of(report, eta, Illumination::PencilBeam);
+        let diffuse = walks_of(report, eta, Illumination::Diffuse);
+        let _ = writeln!(
+            s,
+            "\n## η = {eta}\n\n### The walk's totals\n\nNoise: the walk's mean relative standard error over the compared bins; a model equal to the truth would show a mean relative error of about 0.8 × this (the mean of |N(0, σ)| is 0.8σ).\n\n| α′ | pencil | pencil: noise | diffuse | diffuse: noise |\n|---:|---:|---:|---:|---:|"
+        );
+        for (p, d) in pencil.iter().zip(&diffuse) {
+            let _ = writeln!(
+                s,
+                "| {} | {:.5} ± {:.5} | {:.1}% | {:.5} ± {:.5} | {:.1}% |",
+                p.profile.settings.albedo,
+                p.profile.total,
+                p.profile.total_std_error,
+                100.0 * walk_noise(&p.profile),
+                d.profile.total,
+                d.profile.total_std_error,
+                100.0 * walk_noise(&d.profile)
+            );
+        }
+        for (m, model) in MODELS.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "\n### {} (η = {eta})\n\nTotal error = (model − walk) / walk; mean rel. = mean |R_model − R_walk| / R_walk over [{}, {}] ℓ_u; signed = its signed mean (negative: too dark).\n\n| α′ | pencil: total error | pencil: mean rel. | pencil: signed | diffuse: total error | diffuse: mean rel. | diffuse: signed |\n|---:|---:|---:|---:|---:|---:|---:|",
+                model.name, COMPARE_RANGE.0, COMPARE_RANGE.1
+            );
+            for (p, d) in pencil.iter().zip(&diffuse) {
+                let (a, b) = (p.models[m].1, d.models[m].1);
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {:.1}% | {} | {} | {:.1}% | {} |",
+                    p.profile.settings.albedo,
+                    percent(a.total_relative_error),
+                    100.0 * a.mean_relative_error,
+                    percent(a.mean_signed_relative_error),
+                    percent(b.total_relative_error),
+                    100.0 * b.mean_relative_error,
+                    percent(b.mean_signed_relative_error)
+                );
+            }
+        }
+    }
     if !report.checks.is_empty() {
         let _ = writeln!(
             s,
-            "## The walk at η = 1 against Chandrasekhar\n\n{} photons per walk; the exact totals are 1 − H(1)√(1 − α′) (pencil) and 1 − 2√(1 − α′)∫H μ dμ (diffuse).\n\n| illumination | α′ | walk | exact | z |\n|---|---:|---:|---:|---:|",
-            c.check_photons
+            "\n## The walk at η = 1 against Chandrasekhar\n\nThe exact totals of an index-matched half-space: 1 − H(1)√(1 − α′) under the pencil beam, 1 − 2√(1 − α′)∫H μ dμ under diffuse light.\n\n| illumination | α′ | walk | exact | z |\n|---|---:|---:|---:|---:|"
         );
         for r in &report.checks {
             let _ = writeln!(
@@ -312,51 +396,7 @@ pub fn markdown(report: &ProfilesReport) -> String {
                 r.walk,
                 r.std_error,
                 r.exact,
-                (r.walk - r.exact) / r.std_error
-            );
-        }
-        s.push('\n');
-    }
-    let _ = writeln!(
-        s,
-        "## The walk's totals (η = {})\n\nNoise: the walk's mean relative standard error over the compared bins; a model equal to the truth would show a mean relative error of about 0.8 × this (the mean of |N(0, σ)| is 0.8σ).\n\n| α′ | pencil | pencil: noise | diffuse | diffuse: noise |\n|---:|---:|---:|---:|---:|",
-        c.eta
-    );
-    let (pencil, diffuse) = (
-        walks_of(report, Illumination::PencilBeam),
-        walks_of(report, Illumination::Diffuse),
-    );
-    for (p, d) in pencil.iter().zip(&diffuse) {
-        let _ = writeln!(
-            s,
-            "| {} | {:.5} ± {:.5} | {:.1}% | {:.5} ± {:.5} | {:.1}% |",
-            p.profile.settings.albedo,
-            p.profile.total,
-            p.profile.total_std_error,
-            100.0 * walk_noise(&p.profile),
-            d.profile.total,
-            d.profile.total_std_error,
-            100.0 * walk_noise(&d.profile)
-        );
-    }
-    for (m, model) in MODELS.iter().enumerate() {
-        let _ = writeln!(
-            s,
-            "\n## {}\n\nTotal error = (model − walk) / walk; mean rel. = mean |R_model − R_walk| / R_walk over [{}, {}] ℓ_u; signed = its signed mean (negative: too dark).\n\n| α′ | pencil: total error | pencil: mean rel. | pencil: signed | diffuse: total error | diffuse: mean rel. | diffuse: signed |\n|---:|---:|---:|---:|---:|---:|---:|",
-            model.name, COMPARE_RANGE.0, COMPARE_RANGE.1
-        );
-        for (p, d) in pencil.iter().zip(&diffuse) {
-            let (a, b) = (p.models[m].1, d.models[m].1);
-            let _ = writeln!(
-                s,
-                "| {} | {} | {:.1}% | {} | {} | {:.1}% | {} |",
-                p.profile.settings.albedo,
-                percent(a.total_relative_error),
-                100.0 * a.mean_relative_error,
-                percent(a.mean_signed_relative_error),
-                percent(b.total_relative_error),
-                100.0 * b.mean_relative_error,
-                percent(b.mean_signed_relative_error)
+                r.z()
             );
         }
     }
@@ -452,7 +492,12 @@ fn model_curves(p: &RadialProfile) -> Vec<ModelCurve> {
 /// bins thin out.
 const PLOT_RANGE: (f64, f64) = (0.01, 30.0);
 
-/// Draws `profile-<illumination>-<α′>.svg` for each plotted albedo; returns the files.
+/// The chart of one walk: `profile-eta<η>-<illumination>-<α′>.svg`.
+pub fn plot_file(eta: f64, illumination: Illumination, albedo: f64) -> String {
+    format!("profile-eta{eta}-{}-{albedo}.svg", illumination.name())
+}
+
+/// Draws [`plot_file`] for each plotted albedo at every η; returns the files.
 pub fn write_plots(report: &ProfilesReport, out: &Path) -> Result<Vec<PathBuf>, BenchError> {
     let mut written = Vec::new();
     for w in &report.walks {
@@ -498,10 +543,10 @@ pub fn write_plots(report: &ProfilesReport, out: &Path) -> Result<Vec<PathBuf>, 
             log_y: true,
         };
         let svg = render_chart(&chart, 800, 560)?;
-        let path = out.join(format!(
-            "profile-{}-{}.svg",
-            p.settings.illumination.name(),
-            p.settings.albedo
+        let path = out.join(plot_file(
+            p.settings.eta,
+            p.settings.illumination,
+            p.settings.albedo,
         ));
         write_text_atomically(&path, &svg)?;
         written.push(path);
@@ -518,7 +563,6 @@ mod tests {
         ProfilesConfig {
             albedos: vec![0.5, 0.95],
             photons: 20_000,
-            check_photons: 20_000,
             plot_albedos: vec![0.95],
             threads: Some(2),
             ..ProfilesConfig::full()
@@ -528,37 +572,43 @@ mod tests {
     #[test]
     fn a_small_run_writes_consistent_tables_and_charts() {
         let report = run(&tiny(), &mut |_| {}).unwrap();
-        assert_eq!(report.walks.len(), 4);
-        assert_eq!(report.checks.len(), 6);
+        assert_eq!(report.walks.len(), 8);
+        assert_eq!(report.checks.len(), 4);
         for c in &report.checks {
             // Chandrasekhar's totals: the walk is within 4.5 standard errors of each.
-            assert!((c.walk - c.exact).abs() < 4.5 * c.std_error, "{c:?}");
+            assert!(c.z().abs() < 4.5, "{c:?}");
         }
         // The dipole's comparison is the core's, on the same walk.
         for w in &report.walks {
             let p = &w.profile;
-            let d = UnitDipole::new(p.settings.albedo, 1.3);
-            let want = walk::compare(p, |r| d.rd(r), total_reflectance(p.settings.albedo, 1.3));
+            let (albedo, eta) = (p.settings.albedo, p.settings.eta);
+            let d = UnitDipole::new(albedo, eta);
+            let want = walk::compare(p, |r| d.rd(r), total_reflectance(albedo, eta));
             assert_eq!(w.models[0].1, want);
         }
 
         let md = markdown(&report);
-        assert!(md.contains("## classical dipole"));
+        assert!(md.contains("### classical dipole (η = 1.3)"));
+        assert!(md.contains("### better dipole (η = 1)"));
+        // α′ = 0.95 in each η's totals table and each model's.
         let rows = md.lines().filter(|l| l.starts_with("| 0.95 |")).count();
-        assert_eq!(rows, 1 + MODELS.len());
+        assert_eq!(rows, 2 * (1 + MODELS.len()));
 
         let table = csv(&report);
         let lines: Vec<&str> = table.lines().collect();
-        assert_eq!(lines.len(), 1 + 4 * MODELS.len());
+        assert_eq!(lines.len(), 1 + 8 * MODELS.len());
         let columns = lines[0].split(',').count();
         assert!(lines.iter().all(|l| l.split(',').count() == columns));
         let bins = bins_csv(&report);
-        assert_eq!(bins.lines().count(), 1 + 4 * 100);
+        assert_eq!(bins.lines().count(), 1 + 8 * 100);
+        let columns = bins.lines().next().unwrap().split(',').count();
+        assert_eq!(columns, 8 + MODELS.len());
 
         let dir = std::env::temp_dir().join(format!("lucent-profiles-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let files = write_plots(&report, &dir).unwrap();
-        assert_eq!(files.len(), 2);
+        assert_eq!(files.len(), 4);
+        assert!(files.contains(&dir.join("profile-eta1.3-pencil-0.95.svg")));
         for f in &files {
             let svg = std::fs::read_to_string(f).unwrap();
             check_well_formed(&svg).unwrap();
@@ -571,7 +621,7 @@ mod tests {
     fn the_thread_count_does_not_change_the_result() {
         let one = ProfilesConfig {
             albedos: vec![0.7],
-            check_photons: 0,
+            etas: vec![1.3],
             threads: Some(1),
             ..tiny()
         };
@@ -583,6 +633,7 @@ mod tests {
             run(&one, &mut |_| {}).unwrap(),
             run(&two, &mut |_| {}).unwrap(),
         );
+        assert!(a.checks.is_empty());
         for (x, y) in a.walks.iter().zip(&b.walks) {
             assert_eq!(x.profile, y.profile);
         }

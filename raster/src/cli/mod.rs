@@ -253,9 +253,9 @@ pub struct BenchArgs {
     /// against relRMSE beside pbrt-v2's), writing peer.md and peer.csv; about a minute.
     #[arg(long)]
     pub peer: bool,
-    /// Run only the diffusion profiles against a Monte Carlo random walk (η = 1.3, seven
-    /// albedos, pencil beam and diffuse light), writing profiles.md, profiles.csv,
-    /// profile-bins.csv and SVG charts of R(r); about a minute on one core.
+    /// Run only the diffusion profiles against a Monte Carlo random walk (η = 1.3 and 1,
+    /// seven albedos, pencil beam and diffuse light), writing profiles.md, profiles.csv,
+    /// profile-bins.csv and SVG charts of R(r); about 70 s on one core.
     #[arg(long, conflicts_with = "peer")]
     pub profiles: bool,
     /// Only these scenes (default, sphere, textured), comma-separated.

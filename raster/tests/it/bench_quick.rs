@@ -300,13 +300,17 @@ fn the_profiles_comparison_runs_alone() {
     );
     let md = std::fs::read_to_string(out.join("profiles.md")).unwrap();
     assert!(md.contains("## classical dipole"), "{md}");
-    // α′ = 0.99 in the totals table and in every model's.
+    // α′ = 0.99 in each η's totals table and every model's, η = 1.3 and 1.
     let rows = md.lines().filter(|l| l.starts_with("| 0.99 |")).count();
-    assert_eq!(rows, 1 + lucent_raster::bench::MODELS.len());
+    assert_eq!(rows, 2 * (1 + lucent_raster::bench::MODELS.len()));
+    assert!(
+        md.contains("## The walk at η = 1 against Chandrasekhar"),
+        "{md}"
+    );
     for file in [
         "profiles.csv",
         "profile-bins.csv",
-        "profile-pencil-0.95.svg",
+        "profile-eta1.3-pencil-0.95.svg",
     ] {
         assert!(out.join(file).exists(), "{file}");
     }
