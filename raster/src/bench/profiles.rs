@@ -13,7 +13,8 @@
 //!                              the model averaged over each annulus as the walk scores it
 //! report: profiles.md, profiles.csv (one row per model × η × illumination × α′),
 //!         profile-bins.csv (every bin: walk, its error, every model),
-//!         profile-eta<η>-<illumination>-<α′>.svg (log R against log r/ℓ_u, walk and models)
+//!         profile-eta<η>-<illumination>-<α′>.svg (log R against log r/ℓ_u, walk and models),
+//!         profile-ratio-eta<η>-<illumination>-<α′>.svg (each model / walk against r/ℓ_u)
 //! ```
 //!
 //! A model is one entry of [`MODELS`]: a name and a function from [`ModelInput`] (α′, η, the
@@ -497,16 +498,41 @@ pub fn plot_file(eta: f64, illumination: Illumination, albedo: f64) -> String {
     format!("profile-eta{eta}-{}-{albedo}.svg", illumination.name())
 }
 
-/// Draws [`plot_file`] for each plotted albedo at every η; returns the files.
+/// The chart of every model divided by the walk: `profile-ratio-eta<η>-<illumination>-<α′>.svg`.
+pub fn ratio_plot_file(eta: f64, illumination: Illumination, albedo: f64) -> String {
+    format!(
+        "profile-ratio-eta{eta}-{}-{albedo}.svg",
+        illumination.name()
+    )
+}
+
+/// Bins whose walk value has a larger relative standard error are left out of the ratio
+/// chart: their ratio would be noise.
+const RATIO_MAX_NOISE: f64 = 0.1;
+
+/// Draws, for each plotted albedo at every η, R(r) of the walk and every model
+/// ([`plot_file`], log–log: the shapes over five decades) and every model's ratio to the walk
+/// ([`ratio_plot_file`], where errors of a few percent show); returns the files.
 pub fn write_plots(report: &ProfilesReport, out: &Path) -> Result<Vec<PathBuf>, BenchError> {
     let mut written = Vec::new();
     for w in &report.walks {
         let p = &w.profile;
-        if !report.config.plot_albedos.contains(&p.settings.albedo) {
+        let settings = &p.settings;
+        if !report.config.plot_albedos.contains(&settings.albedo) {
             continue;
         }
         let shown: Vec<usize> = (0..p.len())
             .filter(|&i| (PLOT_RANGE.0..=PLOT_RANGE.1).contains(&p.centre(i)))
+            .collect();
+        // Each model's annulus means over the shown bins.
+        let means: Vec<Vec<f64>> = model_curves(p)
+            .iter()
+            .map(|curve| {
+                shown
+                    .iter()
+                    .map(|&i| walk::annulus_mean(&curve.rd, p.edges[i], p.edges[i + 1]))
+                    .collect()
+            })
             .collect();
         let mut series = vec![Series {
             label: "random walk".to_string(),
@@ -515,41 +541,69 @@ pub fn write_plots(report: &ProfilesReport, out: &Path) -> Result<Vec<PathBuf>, 
                 .map(|&i| (p.centre(i), p.reflectance[i]))
                 .collect(),
         }];
-        for (model, curve) in MODELS.iter().zip(model_curves(p)) {
+        // The walk as the line at 1, so that each model keeps its colour of the other chart.
+        let mut ratios = vec![Series {
+            label: "random walk (= 1)".to_string(),
+            points: shown.iter().map(|&i| (p.centre(i), 1.0)).collect(),
+        }];
+        for (model, values) in MODELS.iter().zip(&means) {
             series.push(Series {
                 label: model.name.to_string(),
                 points: shown
                     .iter()
-                    .map(|&i| {
-                        let mean = walk::annulus_mean(&curve.rd, p.edges[i], p.edges[i + 1]);
-                        (p.centre(i), mean)
-                    })
+                    .zip(values)
+                    .map(|(&i, &v)| (p.centre(i), v))
+                    .collect(),
+            });
+            ratios.push(Series {
+                label: model.name.to_string(),
+                points: shown
+                    .iter()
+                    .zip(values)
+                    .filter(|&(&i, _)| p.std_error[i] <= RATIO_MAX_NOISE * p.reflectance[i])
+                    .filter(|&(&i, _)| p.reflectance[i] > 0.0)
+                    .map(|(&i, &v)| (p.centre(i), v / p.reflectance[i]))
                     .collect(),
             });
         }
-        let illumination = match p.settings.illumination {
+        let illumination = match settings.illumination {
             Illumination::PencilBeam => "pencil beam",
             Illumination::Diffuse => "diffuse",
         };
-        let chart = Chart {
-            title: format!(
-                "R(r), α′ = {}, η = {}, {illumination}",
-                p.settings.albedo, p.settings.eta
+        let what = format!(
+            "α′ = {}, η = {}, {illumination}",
+            settings.albedo, settings.eta
+        );
+        let charts = [
+            (
+                Chart {
+                    title: format!("R(r), {what}"),
+                    x_label: "r / ℓ_u".to_string(),
+                    y_label: "R(r) · ℓ_u²".to_string(),
+                    series,
+                    log_x: true,
+                    log_y: true,
+                },
+                plot_file(settings.eta, settings.illumination, settings.albedo),
             ),
-            x_label: "r / ℓ_u".to_string(),
-            y_label: "R(r) · ℓ_u²".to_string(),
-            series,
-            log_x: true,
-            log_y: true,
-        };
-        let svg = render_chart(&chart, 800, 560)?;
-        let path = out.join(plot_file(
-            p.settings.eta,
-            p.settings.illumination,
-            p.settings.albedo,
-        ));
-        write_text_atomically(&path, &svg)?;
-        written.push(path);
+            (
+                Chart {
+                    title: format!("model / walk, {what}"),
+                    x_label: "r / ℓ_u".to_string(),
+                    y_label: "R_model / R_walk".to_string(),
+                    series: ratios,
+                    log_x: true,
+                    log_y: true,
+                },
+                ratio_plot_file(settings.eta, settings.illumination, settings.albedo),
+            ),
+        ];
+        for (chart, file) in charts {
+            let svg = render_chart(&chart, 800, 560)?;
+            let path = out.join(file);
+            write_text_atomically(&path, &svg)?;
+            written.push(path);
+        }
     }
     Ok(written)
 }
@@ -607,8 +661,9 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("lucent-profiles-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let files = write_plots(&report, &dir).unwrap();
-        assert_eq!(files.len(), 4);
+        assert_eq!(files.len(), 8);
         assert!(files.contains(&dir.join("profile-eta1.3-pencil-0.95.svg")));
+        assert!(files.contains(&dir.join("profile-ratio-eta1-diffuse-0.95.svg")));
         for f in &files {
             let svg = std::fs::read_to_string(f).unwrap();
             check_well_formed(&svg).unwrap();
