@@ -5,8 +5,8 @@
 //!
 //! **What it simulates.** The medium fills z > 0. Lengths are in units of the mean free path
 //! ℓ_u = 1/σ_t′, so the reduced extinction is σ_t′ = 1, and scattering is isotropic with the
-//! reduced albedo α′ = σ_s′/σ_t′ — the similarity relation that the dipole's own derivation
-//! makes (J01 §2.3), so that the walk and the models describe the same medium. Each photon
+//! reduced albedo α′ = σ_s′/σ_t′ — the similarity relation σ_s′ = σ_s(1 − g) on which the
+//! dipole rests (J01), so that the walk and the models describe the same medium. Each photon
 //! carries weight 1 (analogue: no weights, no roulette): free paths are drawn from e^(−s);
 //! at each interaction the photon is absorbed with probability 1 − α′ and otherwise takes a
 //! uniformly random direction. The boundary z = 0 is a smooth dielectric of relative index
@@ -32,11 +32,18 @@
 //! integer counts only, so the profile is the same bits however the chunks are spread over
 //! threads and in whatever order their tallies are merged.
 //!
-//! **Checks.** With η = 1 the pencil beam's total is Chandrasekhar's plane albedo
-//! 1 − H(1)√(1 − α′) and the diffuse total his spherical albedo ([`HFunction`]), which the
-//! tests below compare with the walk. `lucent bench --profiles` runs it at a fine setting
-//! against every model (`BENCHMARKS.md`, "Profiles against a Monte Carlo random walk").
-//! Every transcendental goes through `crate::math`.
+//! **Checks** (the tests in `random_walk/tests.rs`). With η = 1 the pencil beam's total is
+//! Chandrasekhar's plane albedo 1 − H(1)√(1 − α′) and the diffuse total his spherical albedo
+//! ([`HFunction`]); at any η the share of photons leaving after exactly one scattering
+//! ([`Tally::single_scattered`]) has a closed form through the Fresnel boundary; at η = 1
+//! Christensen & Burley's published fits, made from their own Monte Carlo, match the walk's
+//! profiles to a few percent.
+//!
+//! **What it is for.** Measuring diffusion profiles: `lucent bench --profiles` runs the walk
+//! at a fine setting against every model the core has (`BENCHMARKS.md`, "Profiles against a
+//! Monte Carlo random walk"), and the tests pin what is known about the classical dipole. It
+//! is a reference, not a renderer's profile: nothing in the queries calls it. Every
+//! transcendental goes through `crate::math`.
 
 mod chandrasekhar;
 mod compare;
