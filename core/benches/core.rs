@@ -8,11 +8,11 @@
 use divan::{Bencher, black_box};
 use lucent_core::glam::Vec3;
 use lucent_core::internals::exhaustive_sum_lanes;
-use lucent_core::internals::{Lanes, ScalarLanes, SimdLanes};
+use lucent_core::internals::{Lanes, NodeMoments, ScalarLanes, SimdLanes};
 use lucent_core::stats::{NoStats, QueryStats};
 use lucent_core::{
-    IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, QuerySettings, Sample,
-    ShadingPoint,
+    Distance, IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, ProfileModel,
+    QuerySettings, Sample, ShadingPoint,
 };
 
 const N: usize = 23_000;
@@ -168,6 +168,59 @@ fn rd_lanes<L: Lanes>(b: Bencher) {
         }
         acc.reduce_add()
     });
+}
+
+/// RGB profile evaluations in 8-lane batches per model (SIMD lanes), the cost that a traversal
+/// pays per sample or aggregate: the plain value and the fourth-order node aggregate.
+#[divan::bench(args = ProfileModel::ALL.map(|m| m.name()), counter = divan::counter::ItemsCount::new(1024usize))]
+fn rd_lanes_per_model(b: Bencher, model: &str) {
+    let p = model_profile(model);
+    let r2: Vec<f32> = (0..1024 + 8).map(|i| i as f32 * 1e-3).collect();
+    b.bench(|| {
+        let mut acc = SimdLanes::splat(0.0);
+        for i in (0..1024).step_by(8) {
+            let rd = p.rd_lanes(SimdLanes::load(&r2[i..]));
+            acc = acc + rd[0] + rd[1] + rd[2];
+        }
+        acc.reduce_add()
+    });
+}
+
+/// The fourth-order node aggregate per model (SIMD lanes), per RGB evaluation.
+#[divan::bench(args = ProfileModel::ALL.map(|m| m.name()), counter = divan::counter::ItemsCount::new(1024usize))]
+fn rd_lanes_corrected_per_model(b: Bencher, model: &str) {
+    let p = model_profile(model);
+    let r2: Vec<f32> = (0..1024 + 8).map(|i| 0.01 + i as f32 * 1e-3).collect();
+    let m = NodeMoments {
+        q: SimdLanes::splat(1e-5),
+        trace: SimdLanes::splat(2e-5),
+        cross: SimdLanes::splat(1e-10),
+        trace_sq: SimdLanes::splat(2e-10),
+    };
+    b.bench(|| {
+        let mut acc = SimdLanes::splat(0.0);
+        for i in (0..1024).step_by(8) {
+            let rd = p.rd_lanes_corrected(SimdLanes::load(&r2[i..]), black_box(&m));
+            acc = acc + rd[0] + rd[1] + rd[2];
+        }
+        acc.reduce_add()
+    });
+}
+
+/// The bench sphere's marble under the model named `name`, same K_d and ℓ_u.
+fn model_profile(name: &str) -> Profile {
+    let base = setup().profile;
+    let model = ProfileModel::ALL
+        .into_iter()
+        .find(|m| m.name() == name)
+        .expect("a model name");
+    Profile::from_reflectance_with(
+        model,
+        base.total_reflectance(),
+        Distance::MeanFreePath(base.mean_free_path()),
+        base.eta(),
+    )
+    .unwrap()
 }
 
 /// Cache construction, samples per second.

@@ -1,4 +1,4 @@
-//! d'Eon's better dipole (2012, "A better dipole"; `docs/physics.md` §19), one colour channel:
+//! d'Eon's better dipole (2012, "A better dipole"; `docs/physics.md` §18), one colour channel:
 //! the classical dipole's two sources with Grosjean's diffusion coefficient, a boundary term
 //! from the Fresnel moments, and the exitance taken from both the fluence φ and the flux E:
 //!

@@ -1,5 +1,5 @@
 //! Normalised diffusion (Christensen & Burley 2015, "Approximate reflectance profiles for
-//! efficient subsurface scattering"; `docs/physics.md` §19), one colour channel:
+//! efficient subsurface scattering"; `docs/physics.md` §18), one colour channel:
 //!
 //! ```text
 //! R(r) = A (e^(−r/d) + e^(−r/(3d))) / (8π d r),      ∫ R dA = A for every d,

@@ -3,7 +3,7 @@
 //! preset; plus the conversion from exitance to radiance (the project's convention,
 //! `docs/physics.md` §17).
 //!
-//! The models (`docs/physics.md` §19):
+//! The models (`docs/physics.md` §18):
 //!
 //! | [`ProfileModel`] | channel type | albedo parameter | total reflectance |
 //! |---|---|---|---|

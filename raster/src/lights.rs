@@ -49,6 +49,10 @@ pub struct Lighting<'a> {
     skip: f32,
     /// Only the lights with hard shadows (see [`Lighting::hard_only`]).
     hard_only: bool,
+    /// Whether `lights` holds a light with hard shadows, and one with soft shadows: asked per
+    /// sample and per edge-refined node, so counted once here.
+    any_hard: bool,
+    any_soft: bool,
 }
 
 /// What one thread remembers between shadow rays: the last occluder of each of the first
@@ -86,6 +90,8 @@ impl<'a> Lighting<'a> {
             scale,
             skip: 0.0,
             hard_only: false,
+            any_hard: lights.iter().any(|l| !is_soft(l)),
+            any_soft: lights.iter().any(is_soft),
         }
     }
 
@@ -103,12 +109,12 @@ impl<'a> Lighting<'a> {
 
     /// True if some light's shadows have hard edges ([`Lighting::hard_only`] keeps it).
     pub fn has_hard_lights(&self) -> bool {
-        self.lights.iter().any(|l| !is_soft(l))
+        self.any_hard
     }
 
     /// True if some light is left out by [`Lighting::hard_only`].
     pub fn has_soft_lights(&self) -> bool {
-        self.lights.iter().any(is_soft)
+        self.any_soft
     }
 
     /// The same lights with shadow rays that ignore occluders within `distance` of the point
