@@ -89,6 +89,8 @@ fn mesh_files_are_checked() {
     };
     let textured = "kd = { texture = 'ramp.png' }\nmean_free_path = 1\neta = 1.3";
     let no_uvs = obj("nouv.obj").replacen(PRESET, textured, 1);
+    let radius = "kd = 0.5\nradius = { texture = 'ramp.png', min = 0.1, max = 1 }\neta = 1.3";
+    let no_uvs_radius = obj("nouv.obj").replacen(PRESET, radius, 1);
     expect_all! { SceneErrorKind::Io;
         obj("missing.obj") => "missing.obj", "object[0].obj", "cannot read mesh";
     }
@@ -99,6 +101,7 @@ fn mesh_files_are_checked() {
         obj("nan.obj") => "nan.obj", "object[0].obj", "not finite";
         obj("empty.obj") => "empty.obj", "object[0].obj", "no faces";
         no_uvs => "nouv.obj", "object[0].obj", "no texture coordinates";
+        no_uvs_radius => "nouv.obj", "object[0].obj", "`radius`";
     }
     // The same with UVs loads, and so do the shapes (which always have UVs).
     let s = load(&obj("quad.obj").replacen(PRESET, textured, 1)).expect("UVs present");
