@@ -168,7 +168,7 @@ def table_seeds():
 def scene_seeds():
     t = "scene_parse_never_panics"
     for name in ("default", "sphere-shadow", "textured-mfp", "rect-light", "environment",
-                 "obj-materials"):
+                 "obj-materials", "burley-marble"):
         with open(os.path.join(ROOT, "scenes", name + ".toml"), "rb") as f:
             write(t, name + ".toml", f.read())
     every = b"""
@@ -199,6 +199,13 @@ radius = 2.0
 material = "skin"
 
 [[object]]
+shape = "sphere"
+radius = 0.5
+segments = 12
+translate = [2.0, 0.0, 0.5]
+material = "wax"
+
+[[object]]
 shape = "box"
 size = [3.0, 7.6, 0.05]
 translate = [-1.5, 0.2, 2.6]
@@ -215,11 +222,21 @@ type = "translucent"
 sigma_a = [0.02, 0.05, 0.3]
 sigma_s_prime = [10.0, 12.0, 14.0]
 eta = 1.33
+profile = "better-dipole"
 
 [material.skin]
 type = "translucent"
 kd = { texture = "textures/mfp-ramp.png" }
 diffuse_mean_free_path = 0.5
+eta = 1.4
+profile = "burley-diffuse"
+
+[material.wax]
+type = "translucent"
+profile = "burley"
+kd = [0.8, 0.6, 0.4]
+radius = { texture = "textures/mfp-ramp.png", min = 0.1, max = 2.0 }
+radius_scale = 0.5
 eta = 1.4
 
 [material.grey]

@@ -2,8 +2,9 @@
 //! `docs/physics.md` §14).
 //!
 //! A [`LocalIntegralTable`] serves every ℓ_u of one material because K depends on α/ℓ_u and the
-//! reduced albedo α′ only, and α′ is fixed by K_d. Where K_d varies over the surface, α′ does
-//! too, so one table per K_d is needed: [`LocalIntegralByKd`] holds tables at the
+//! model's albedo parameter only (α′ for the dipoles, A for Burley), and that is fixed by K_d.
+//! Where K_d varies over the surface, the albedo parameter does too, so one table per K_d is
+//! needed: [`LocalIntegralByKd`] holds tables at the
 //! [`LocalIntegralByKd::LEVELS`] + 1 evenly spaced K_d = i / LEVELS (clamped into
 //! [0.001, 0.999]) and interpolates linearly in K_d, per channel, between the two bracketing
 //! tables, each looked up at the point's ℓ_u:
@@ -24,7 +25,7 @@ use glam::Vec3;
 
 use crate::error::ParamError;
 use crate::local_term::LocalTerm;
-use crate::profile::{Distance, Profile};
+use crate::profile::{Distance, Profile, ProfileModel};
 use crate::table::LocalIntegralTable;
 
 /// Local-integral tables at evenly spaced K_d for one η and smoothing radius α, for a material
@@ -42,15 +43,27 @@ impl LocalIntegralByKd {
     /// Intervals between the K_d levels (the tables are one more).
     pub const LEVELS: usize = 64;
 
-    /// The tables for relative index `eta`, smoothing radius `alpha` and threshold `ell_min`
-    /// (scene units; as [`LocalIntegralTable::new`]). Only the tables' headers are built here;
-    /// their values are computed by the lookups that need them.
+    /// The classical dipole's tables for relative index `eta`, smoothing radius `alpha` and
+    /// threshold `ell_min` (scene units; as [`LocalIntegralTable::new`]). Only the tables'
+    /// headers are built here; their values are computed by the lookups that need them.
     pub fn new(eta: f32, alpha: f32, ell_min: f32) -> Result<Self, ParamError> {
+        Self::for_model(ProfileModel::Dipole, eta, alpha, ell_min)
+    }
+
+    /// [`LocalIntegralByKd::new`] for the profiles of `model`: level i holds the table of the
+    /// profile whose total reflectance is that level's K_d under `model`.
+    pub fn for_model(
+        model: ProfileModel,
+        eta: f32,
+        alpha: f32,
+        ell_min: f32,
+    ) -> Result<Self, ParamError> {
         let levels = (0..=Self::LEVELS)
             .map(|i| {
                 let kd = (i as f32 / Self::LEVELS as f32).clamp(0.001, 0.999);
                 // ℓ_u is what each table varies; 1 is as good as any.
-                let profile = Profile::from_reflectance(
+                let profile = Profile::from_reflectance_with(
+                    model,
                     Vec3::splat(kd),
                     Distance::MeanFreePath(Vec3::ONE),
                     eta,
@@ -171,6 +184,48 @@ mod tests {
             ((top - last) / last).abs().max_element() < 1e-6,
             "{top} vs {last}"
         );
+    }
+
+    /// Every model: between levels within 0.2% of a table built for that model at exactly that
+    /// K_d, and each level is that model's table (the Burley levels differ from the dipole's).
+    #[test]
+    fn every_model_takes_its_own_tables() {
+        let (eta, alpha) = (1.4, 0.07);
+        let ell = Vec3::new(0.005, 0.05, 0.5);
+        let dipole = LocalIntegralByKd::new(eta, alpha, alpha / 1024.0).unwrap();
+        for model in ProfileModel::ALL {
+            let tables = LocalIntegralByKd::for_model(model, eta, alpha, alpha / 1024.0).unwrap();
+            let mut worst = 0.0f32;
+            for kd in [Vec3::new(0.3, 0.55, 0.9), Vec3::new(0.05, 0.12, 0.71)] {
+                let got = tables.lookup(kd, ell);
+                let profile =
+                    Profile::from_reflectance_with(model, kd, Distance::MeanFreePath(ell), eta)
+                        .unwrap();
+                let own = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0)
+                    .unwrap()
+                    .lookup(ell);
+                worst = worst.max(((got - own) / own).abs().max_element());
+            }
+            assert!(
+                worst < 0.002,
+                "{}: worst relative error {worst}",
+                model.name()
+            );
+            let at_level = Vec3::splat(16.0 / 64.0);
+            let level = Profile::from_reflectance_with(
+                model,
+                at_level,
+                Distance::MeanFreePath(Vec3::ONE),
+                eta,
+            )
+            .unwrap();
+            let own = LocalIntegralTable::new(&level, alpha, alpha / 1024.0).unwrap();
+            assert_eq!(tables.lookup(at_level, ell), own.lookup(ell), "{model:?}");
+            if let ProfileModel::Burley(_) = model {
+                let (k, d) = (tables.lookup(at_level, ell), dipole.lookup(at_level, ell));
+                assert!(((k - d) / d).abs().max_element() > 0.01, "{k} vs {d}");
+            }
+        }
     }
 
     #[test]

@@ -2,19 +2,29 @@
 //! or from texture-mapped K_d and mean free path) and the local integral K of the split
 //! methods at that point.
 //!
-//! Texture-mapped ℓ with constant K_d is N10's case: α′ is fixed, so one
-//! [`LocalIntegralTable`] (cached at powers of two of ℓ) serves every point. A texture-mapped
-//! K_d also varies α′; K then comes from the core's [`LocalIntegralByKd`], tables at evenly
-//! spaced K_d interpolated linearly in K_d per channel.
+//! Every profile of a material is of the material's [`ProfileModel`]: the constant one, the
+//! per-point ones of texture-mapped parameters (K_d inverted by that model's
+//! [`AlbedoInverter`]) and the local-integral tables.
+//!
+//! Texture-mapped ℓ with constant K_d is N10's case: the albedo parameter (α′ for the dipoles,
+//! A for Burley) is fixed, so one [`LocalIntegralTable`] (cached at powers of two of ℓ) serves
+//! every point. A texture-mapped K_d also varies the albedo parameter; K then comes from the
+//! core's [`LocalIntegralByKd`], tables at evenly spaced K_d interpolated linearly in K_d per
+//! channel.
+//!
+//! A diffuse mean free path ℓ_d is converted to ℓ_u with the classical dipole's relation
+//! ℓ_u = ℓ_d √(3(1 − α′)) whatever the model (as the core's `Distance::DiffuseMeanFreePath`),
+//! so a model other than the dipole also keeps the dipole's α′ of K_d for that conversion.
 
 use std::fmt;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use lucent_core::error::ParamError;
-use lucent_core::internals::AlbedoInverter;
+use lucent_core::internals::{AlbedoInverter, KD_MAX, KD_MIN, albedo_from_total_reflectance};
 use lucent_core::{
-    Distance as CoreDistance, LocalIntegralByKd, LocalIntegralTable, LocalTerm, Profile, presets,
+    Distance as CoreDistance, LocalIntegralByKd, LocalIntegralTable, LocalTerm, Profile,
+    ProfileModel, presets,
 };
 
 use crate::scene::{ColorParam, Distance, Material, Medium, ScalarParam, Specular};
@@ -90,6 +100,7 @@ impl Shader {
             Material::Lambert { albedo, .. } => Ok(Shader::Lambert { albedo: *albedo }),
             Material::Translucent(t) => {
                 let err = |e: ParamError| MaterialError::params(&t.name, e);
+                let model = t.model;
                 let params = match &t.medium {
                     Medium::Preset { name, mm_per_unit } => {
                         let preset =
@@ -97,17 +108,20 @@ impl Shader {
                                 material: t.name.clone(),
                                 preset: name.clone(),
                             })?;
-                        Params::Fixed(Profile::from_preset(preset, *mm_per_unit).map_err(err)?)
+                        Params::Fixed(
+                            Profile::from_preset_with(model, preset, *mm_per_unit).map_err(err)?,
+                        )
                     }
                     Medium::Coefficients {
                         sigma_a,
                         sigma_s_prime,
                         eta,
                     } => Params::Fixed(
-                        Profile::from_coefficients(*sigma_a, *sigma_s_prime, *eta).map_err(err)?,
+                        Profile::from_coefficients_with(model, *sigma_a, *sigma_s_prime, *eta)
+                            .map_err(err)?,
                     ),
                     Medium::Reflectance { kd, distance, eta } => {
-                        reflectance_params(kd, distance, *eta).map_err(err)?
+                        reflectance_params(kd, distance, *eta, model).map_err(err)?
                     }
                 };
                 Ok(Shader::Translucent(Box::new(TranslucentShader {
@@ -120,7 +134,8 @@ impl Shader {
     }
 }
 
-/// How the translucent parameters vary over the surface.
+/// How the translucent parameters vary over the surface. The model is the profiles' own
+/// (`base.model()`), kept by every per-point profile derived from `base`.
 #[derive(Debug)]
 pub(crate) enum Params {
     /// The same profile everywhere.
@@ -133,17 +148,61 @@ pub(crate) enum Params {
     },
 }
 
+/// Where K_d comes from, with what turns it into albedo parameters.
 #[derive(Debug)]
 pub(crate) enum KdSource {
-    Constant([f64; 3]),
-    Texture(Arc<Texture>, AlbedoInverter),
+    /// A constant K_d: the model's albedo parameters, and the classical dipole's α′ (for the
+    /// ℓ_d → ℓ_u conversion; the same numbers when the model is the dipole).
+    Constant {
+        albedo: [f64; 3],
+        dipole_albedo: [f64; 3],
+    },
+    /// A texture-mapped K_d, inverted per point by the model's table; `dipole` is the classical
+    /// dipole's table when the model is another one (`None`: the model's α′ is the dipole's).
+    Texture {
+        texture: Arc<Texture>,
+        inverter: AlbedoInverter,
+        dipole: Option<AlbedoInverter>,
+    },
 }
 
-/// Validates every constant and both ends of every texture range by building profiles there.
+impl KdSource {
+    /// The model's albedo parameters and the dipole's α′ at K_d = `kd` (a texture's value,
+    /// already clamped; ignored for a constant).
+    fn albedos(&self, kd: Vec3) -> ([f64; 3], [f64; 3]) {
+        match self {
+            KdSource::Constant {
+                albedo,
+                dipole_albedo,
+            } => (*albedo, *dipole_albedo),
+            KdSource::Texture {
+                inverter, dipole, ..
+            } => {
+                let invert = |t: &AlbedoInverter| [t.albedo(kd.x), t.albedo(kd.y), t.albedo(kd.z)];
+                let albedo = invert(inverter);
+                (albedo, dipole.as_ref().map_or(albedo, invert))
+            }
+        }
+    }
+}
+
+/// σ_t′ per channel from a distance value `l` (ℓ_u, or ℓ_d with the dipole's α′).
+fn extinction(distance: &Distance, l: Vec3, dipole_albedo: [f64; 3]) -> [f64; 3] {
+    match distance {
+        Distance::MeanFreePath(_) => [1.0 / l.x as f64, 1.0 / l.y as f64, 1.0 / l.z as f64],
+        Distance::DiffuseMeanFreePath(_) => {
+            std::array::from_fn(|c| (1.0 / l[c] as f64) / (3.0 * (1.0 - dipole_albedo[c])).sqrt())
+        }
+    }
+}
+
+/// Validates every constant and both ends of every texture range by building profiles of
+/// `model` there.
 pub(crate) fn reflectance_params(
     kd: &ColorParam,
     distance: &Distance,
     eta: f32,
+    model: ProfileModel,
 ) -> Result<Params, ParamError> {
     let representative_kd = match kd {
         ColorParam::Constant(v) => *v,
@@ -163,16 +222,34 @@ pub(crate) fn reflectance_params(
             (lo, hi, CoreDistance::DiffuseMeanFreePath)
         }
     };
-    let base = Profile::from_reflectance(representative_kd, make(lo), eta)?;
-    Profile::from_reflectance(representative_kd, make(hi), eta)?;
+    let base = Profile::from_reflectance_with(model, representative_kd, make(lo), eta)?;
+    Profile::from_reflectance_with(model, representative_kd, make(hi), eta)?;
     let kd = match kd {
-        ColorParam::Constant(_) => KdSource::Constant(base.albedo_parameters()),
+        ColorParam::Constant(v) => {
+            let albedo = base.albedo_parameters();
+            let dipole_albedo = if model == ProfileModel::Dipole {
+                albedo
+            } else {
+                // As the core's conversion of ℓ_d: the dipole's α′ of the clamped K_d.
+                let kd = v.clamp(Vec3::splat(KD_MIN), Vec3::splat(KD_MAX));
+                kd.to_array()
+                    .map(|k| albedo_from_total_reflectance(k as f64, eta as f64))
+            };
+            KdSource::Constant {
+                albedo,
+                dipole_albedo,
+            }
+        }
         ColorParam::Texture(t) => {
             // Both ends of the reflectance range must make valid profiles too.
             for v in [0.001, 0.999] {
-                Profile::from_reflectance(Vec3::splat(v), make(lo), eta)?;
+                Profile::from_reflectance_with(model, Vec3::splat(v), make(lo), eta)?;
             }
-            KdSource::Texture(t.clone(), AlbedoInverter::new(eta))
+            KdSource::Texture {
+                texture: t.clone(),
+                inverter: AlbedoInverter::for_model(model, eta),
+                dipole: (model != ProfileModel::Dipole).then(|| AlbedoInverter::new(eta)),
+            }
         }
     };
     Ok(Params::Reflectance {
@@ -252,7 +329,7 @@ impl TranslucentShader {
         match &self.params {
             Params::Fixed(_) => false,
             Params::Reflectance { kd, distance, .. } => {
-                matches!(kd, KdSource::Texture(..))
+                matches!(kd, KdSource::Texture { .. })
                     || matches!(
                         distance,
                         Distance::MeanFreePath(ScalarParam::Texture { .. })
@@ -269,38 +346,70 @@ impl TranslucentShader {
         }
     }
 
-    /// The smallest diffuse mean free path ℓ_d = 1/σ_tr anywhere on the surface, per channel:
-    /// what the irradiance sample spacing must resolve. Textures are bilinear, so their
-    /// extremes are texels: ℓ_u (or ℓ_d) is taken at the texel that makes it smallest, and a
-    /// textured K_d at its smallest texel (ℓ_d = ℓ_u / √(3(1 − α′)) grows with α′, which grows
-    /// with K_d). With both textured the two extremes need not meet at one point, so the value is
-    /// a lower bound there; otherwise it is the minimum.
+    /// The smallest decay length of the profile anywhere on the surface, per channel
+    /// ([`Profile::diffuse_mean_free_path`]: ℓ_d = 1/σ_tr for the dipoles, 3d for Burley): what
+    /// the irradiance sample spacing must resolve.
+    ///
+    /// Textures are bilinear, so their extremes are texels, and at a fixed K_d the decay length
+    /// is proportional to the distance parameter: ℓ_u (or ℓ_d) is taken at the texel that makes
+    /// it smallest. Over a textured K_d: for the classical dipole, at its smallest texel
+    /// (ℓ_d = ℓ_u / √(3(1 − α′)) grows with α′, which grows with K_d); for the other models the
+    /// profile is built at 65 evenly spaced K_d from the smallest to the largest texel, both
+    /// included, and the shortest decay length kept — the minimum whenever it lies at an end,
+    /// which it does from ℓ_u (the better dipole's decay length grows with K_d; Burley's
+    /// 3ℓ_u/s(A) is smallest where the convex s(A) is largest), and within that grid's
+    /// resolution from ℓ_d. With both textured the two extremes need not meet at one point, so
+    /// the value is a lower bound there; otherwise it is the minimum.
     pub fn smallest_diffuse_mean_free_path(&self) -> Vec3 {
-        let (kd, distance) = match &self.params {
+        let (base, kd, distance) = match &self.params {
             Params::Fixed(p) => return p.diffuse_mean_free_path(),
-            Params::Reflectance { kd, distance, .. } => (kd, distance),
+            Params::Reflectance { base, kd, distance } => (base, kd, distance),
         };
+        let smallest_distance = match distance {
+            Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => smallest_scalar(p),
+        };
+        if base.model() != ProfileModel::Dipole {
+            if !self.is_textured() {
+                return base.diffuse_mean_free_path();
+            }
+            let kd_values: Vec<Vec3> = match kd {
+                KdSource::Constant { .. } => vec![Vec3::splat(0.5)],
+                KdSource::Texture { texture, .. } => {
+                    let (lo, hi) = texel_range(texture);
+                    let clamp = |v: Vec3| v.clamp(Vec3::splat(0.001), Vec3::splat(0.999));
+                    let (lo, hi) = (clamp(lo), clamp(hi));
+                    (0..=64).map(|i| lo.lerp(hi, i as f32 / 64.0)).collect()
+                }
+            };
+            // The decay length per unit distance at each K_d, scaled by the smallest distance.
+            let per_unit = kd_values
+                .iter()
+                .filter_map(|&v| {
+                    let (albedo, dipole_albedo) = kd.albedos(v);
+                    let sigma_t = extinction(distance, Vec3::ONE, dipole_albedo);
+                    base.with_albedo_and_extinction(albedo, sigma_t).ok()
+                })
+                .fold(Vec3::INFINITY, |m, p| m.min(p.diffuse_mean_free_path()));
+            return if per_unit.is_finite() {
+                per_unit * smallest_distance
+            } else {
+                base.diffuse_mean_free_path()
+            };
+        }
         let albedo: [f64; 3] = match kd {
-            KdSource::Constant(a) => *a,
-            KdSource::Texture(t, inverter) => {
-                let lo = texel_range(t)
+            KdSource::Constant { albedo, .. } => *albedo,
+            KdSource::Texture { texture, .. } => {
+                let lo = texel_range(texture)
                     .0
                     .clamp(Vec3::splat(0.001), Vec3::splat(0.999));
-                [
-                    inverter.albedo(lo.x),
-                    inverter.albedo(lo.y),
-                    inverter.albedo(lo.z),
-                ]
+                kd.albedos(lo).0
             }
         };
         match distance {
-            Distance::DiffuseMeanFreePath(p) => smallest_scalar(p),
-            Distance::MeanFreePath(p) => {
-                let ell_u = smallest_scalar(p);
-                Vec3::from_array(std::array::from_fn(|c| {
-                    (f64::from(ell_u[c]) / (3.0 * (1.0 - albedo[c])).sqrt()) as f32
-                }))
-            }
+            Distance::DiffuseMeanFreePath(_) => smallest_distance,
+            Distance::MeanFreePath(_) => Vec3::from_array(std::array::from_fn(|c| {
+                (f64::from(smallest_distance[c]) / (3.0 * (1.0 - albedo[c])).sqrt()) as f32
+            })),
         }
     }
 
@@ -315,56 +424,46 @@ impl TranslucentShader {
             }
             Params::Reflectance { base, kd, distance } => (base, kd, distance),
         };
-        let (albedo, kd_value) = match kd {
-            KdSource::Constant(a) => (*a, None),
-            KdSource::Texture(t, inverter) => {
-                let v = t.sample(uv).clamp(Vec3::splat(0.001), Vec3::splat(0.999));
-                (
-                    [
-                        inverter.albedo(v.x),
-                        inverter.albedo(v.y),
-                        inverter.albedo(v.z),
-                    ],
-                    Some(v),
-                )
-            }
+        let kd_value = match kd {
+            KdSource::Constant { .. } => None,
+            KdSource::Texture { texture, .. } => Some(
+                texture
+                    .sample(uv)
+                    .clamp(Vec3::splat(0.001), Vec3::splat(0.999)),
+            ),
         };
-        let sigma_t = match distance {
-            Distance::MeanFreePath(p) => {
-                let l = scalar_at(p, uv);
-                [1.0 / l.x as f64, 1.0 / l.y as f64, 1.0 / l.z as f64]
-            }
-            Distance::DiffuseMeanFreePath(p) => {
-                let l = scalar_at(p, uv);
-                let st = |c: usize| (1.0 / l[c] as f64) / (3.0 * (1.0 - albedo[c])).sqrt();
-                [st(0), st(1), st(2)]
-            }
+        let (albedo, dipole_albedo) = kd.albedos(kd_value.unwrap_or(Vec3::ZERO));
+        let l = match distance {
+            Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, uv),
         };
+        let sigma_t = extinction(distance, l, dipole_albedo);
         Ok(PointMaterial {
             profile: base.with_albedo_and_extinction(albedo, sigma_t)?,
             kd: kd_value,
         })
     }
 
-    /// The local-integral source for smoothing radius `alpha` and threshold `ell_min`.
+    /// The local-integral source for smoothing radius `alpha` and threshold `ell_min`: for a
+    /// texture-mapped K_d, the tables over K_d of the material's model.
     pub fn local_term(&self, alpha: f32, ell_min: f32) -> Result<LocalIntegral, ParamError> {
         let textured_kd = matches!(
             &self.params,
             Params::Reflectance {
-                kd: KdSource::Texture(..),
+                kd: KdSource::Texture { .. },
                 ..
             }
         );
+        let base = self.base_profile();
         if textured_kd {
-            let eta = self.base_profile().eta();
-            Ok(LocalIntegral::ByKd(LocalIntegralByKd::new(
-                eta, alpha, ell_min,
+            Ok(LocalIntegral::ByKd(LocalIntegralByKd::for_model(
+                base.model(),
+                base.eta(),
+                alpha,
+                ell_min,
             )?))
         } else {
             Ok(LocalIntegral::Single(LocalIntegralTable::new(
-                self.base_profile(),
-                alpha,
-                ell_min,
+                base, alpha, ell_min,
             )?))
         }
     }
@@ -407,145 +506,4 @@ impl LocalIntegral {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scene::TranslucentMaterial;
-    use std::path::PathBuf;
-
-    fn texture(values: &[Vec3], width: u32) -> Arc<Texture> {
-        Arc::new(Texture {
-            path: PathBuf::from("test.png"),
-            width,
-            height: values.len() as u32 / width,
-            texels: values.to_vec(),
-        })
-    }
-
-    fn translucent(medium: Medium) -> TranslucentShader {
-        match Shader::new(&Material::Translucent(TranslucentMaterial {
-            name: "m".into(),
-            medium,
-            specular: None,
-        }))
-        .unwrap()
-        {
-            Shader::Translucent(t) => *t,
-            Shader::Lambert { .. } => unreachable!(),
-        }
-    }
-
-    #[test]
-    fn constant_reflectance_matches_the_core() {
-        let kd = Vec3::new(0.8, 0.5, 0.3);
-        let shader = translucent(Medium::Reflectance {
-            kd: ColorParam::Constant(kd),
-            distance: Distance::MeanFreePath(ScalarParam::Constant(Vec3::splat(0.2))),
-            eta: 1.3,
-        });
-        let p = shader.at(Vec2::ZERO).unwrap().profile;
-        assert!((p.total_reflectance() - kd).abs().max_element() < 1e-5);
-        assert!((p.mean_free_path() - Vec3::splat(0.2)).abs().max_element() < 1e-6);
-        assert!(!shader.is_textured());
-    }
-
-    #[test]
-    fn textured_mean_free_path_maps_logarithmically() {
-        // A 2×1 texture: t = 0 on the left, t = 1 on the right; clamp-free lookups at texel
-        // centres.
-        let tex = texture(&[Vec3::ZERO, Vec3::ONE], 2);
-        let shader = translucent(Medium::Reflectance {
-            kd: ColorParam::Constant(Vec3::splat(0.6)),
-            distance: Distance::MeanFreePath(ScalarParam::Texture {
-                texture: tex,
-                min: 0.01,
-                max: 1.0,
-            }),
-            eta: 1.3,
-        });
-        assert!(shader.is_textured());
-        let left = shader
-            .at(Vec2::new(0.25, 0.5))
-            .unwrap()
-            .profile
-            .mean_free_path();
-        let right = shader
-            .at(Vec2::new(0.75, 0.5))
-            .unwrap()
-            .profile
-            .mean_free_path();
-        assert!(
-            (left.x - 0.01).abs() < 1e-6 && (right.x - 1.0).abs() < 1e-5,
-            "{left} {right}"
-        );
-        // K from the single table equals the table's own lookup at that ℓ.
-        let term = shader.local_term(0.1, 1e-4).unwrap();
-        let point = shader.at(Vec2::new(0.75, 0.5)).unwrap();
-        let LocalIntegral::Single(table) = &term else {
-            panic!("expected a single table")
-        };
-        assert_eq!(
-            term.lookup(&point),
-            table.local_term(point.profile.mean_free_path())
-        );
-    }
-
-    /// A texture-mapped K_d takes K from the core's tables over K_d at the texel's K_d (their
-    /// interpolation error is tested in the core, `kd_tables.rs`).
-    #[test]
-    fn textured_reflectance_takes_k_from_the_tables_over_kd() {
-        let kd = Vec3::new(0.3, 0.55, 0.9);
-        let tex = texture(&[kd], 1);
-        let shader = translucent(Medium::Reflectance {
-            kd: ColorParam::Texture(tex),
-            distance: Distance::MeanFreePath(ScalarParam::Constant(Vec3::splat(0.05))),
-            eta: 1.4,
-        });
-        let point = shader.at(Vec2::splat(0.5)).unwrap();
-        assert!((point.profile.total_reflectance() - kd).abs().max_element() < 1e-4);
-        let alpha = 0.07;
-        let term = shader
-            .local_term(alpha, alpha / 1024.0)
-            .unwrap()
-            .lookup(&point);
-        let want = LocalIntegralByKd::new(1.4, alpha, alpha / 1024.0)
-            .unwrap()
-            .local_term(kd, point.profile.mean_free_path());
-        assert_eq!(term, want);
-        assert_eq!(term.alpha(), alpha);
-    }
-
-    #[test]
-    fn invalid_parameters_name_the_material() {
-        let m = Material::Translucent(TranslucentMaterial {
-            name: "wax".into(),
-            medium: Medium::Coefficients {
-                sigma_a: Vec3::new(1.0, -1.0, 1.0),
-                sigma_s_prime: Vec3::ONE,
-                eta: 1.3,
-            },
-            specular: None,
-        });
-        let err = Shader::new(&m).unwrap_err();
-        let message = err.to_string();
-        assert!(
-            message.contains("wax") && message.contains("sigma_a"),
-            "{err}"
-        );
-        // The core's error is kept as the source.
-        let source = std::error::Error::source(&err).expect("a source");
-        assert!(source.downcast_ref::<ParamError>().is_some(), "{source:?}");
-        let m = Material::Translucent(TranslucentMaterial {
-            name: "stone".into(),
-            medium: Medium::Preset {
-                name: "granite".into(),
-                mm_per_unit: 1.0,
-            },
-            specular: None,
-        });
-        let err = Shader::new(&m).unwrap_err();
-        assert_eq!(
-            err.to_string(),
-            "material 'stone': unknown preset 'granite'"
-        );
-    }
-}
+mod tests;

@@ -487,6 +487,7 @@ mod tests {
                 name: "marble".into(),
                 mm_per_unit: 10.0,
             },
+            model: lucent_core::ProfileModel::default(),
             specular: None,
         }))
         .unwrap()

@@ -86,6 +86,9 @@ pub(crate) struct RawMaterial {
     pub kd: Option<Spanned<RawParam>>,
     pub mean_free_path: Option<Spanned<RawParam>>,
     pub diffuse_mean_free_path: Option<Spanned<RawParam>>,
+    pub radius: Option<Spanned<RawParam>>,
+    pub radius_scale: Option<Num>,
+    pub profile: Option<Str>,
     pub specular: Option<Spanned<RawSpecular>>,
     pub albedo: Option<Spanned<Components>>,
 }

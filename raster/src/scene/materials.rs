@@ -4,11 +4,15 @@
 //! A translucent material is given in exactly one of three ways (see `docs/scene-format.md`
 //! and `docs/physics.md` §4): a measured preset of Jensen et al. 2001 with the
 //! scene's scale, explicit coefficients, or the artist parameters of Jensen & Buhler 2002
-//! (diffuse reflectance K_d and one named mean free path).
+//! (diffuse reflectance K_d and one distance: a named mean free path, or Standard Surface's
+//! `radius` × `radius_scale`, which is ℓ_u). Whichever way, `profile` names the diffusion
+//! model (`lucent_core::ProfileModel`).
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use glam::Vec3;
+use lucent_core::ProfileModel;
 use toml::Spanned;
 
 use super::check::{Check, Checked};
@@ -24,6 +28,11 @@ use crate::texture::{Texture, TextureEncoding};
 /// Jensen et al. 2001 in `lucent_core::presets`, the one list.
 pub fn preset_names() -> impl Iterator<Item = &'static str> {
     lucent_core::presets::PRESETS.iter().map(|p| p.name)
+}
+
+/// The names accepted by `profile`, in [`ProfileModel::ALL`]'s order.
+pub fn profile_names() -> impl Iterator<Item = &'static str> {
+    ProfileModel::ALL.iter().map(|m| m.name())
 }
 
 /// Material types accepted by `type`.
@@ -126,6 +135,9 @@ pub(crate) fn build_material(
                 &m.diffuse_mean_free_path,
                 what,
             )?;
+            c.forbid(&key("radius"), &m.radius, what)?;
+            c.forbid(&key("radius_scale"), &m.radius_scale, what)?;
+            c.forbid(&key("profile"), &m.profile, what)?;
             c.forbid(&key("specular"), &m.specular, what)?;
             let albedo = c.require(&key("albedo"), &m.albedo, raw, what)?;
             let albedo = c.rgb(
@@ -145,7 +157,8 @@ pub(crate) fn build_material(
         }
         "translucent" => {
             c.forbid(&key("albedo"), &m.albedo, "a translucent material (use kd)")?;
-            let (medium, texture_key, kd_from_mtl) = build_medium(c, name, raw, textures)?;
+            let model = profile_model(c, &key("profile"), &m.profile)?;
+            let (medium, texture_key, kd_from_mtl) = build_medium(c, name, raw, model, textures)?;
             let specular = match &m.specular {
                 None => None,
                 Some(s) => {
@@ -163,6 +176,7 @@ pub(crate) fn build_material(
                 material: Material::Translucent(TranslucentMaterial {
                     name: name.to_string(),
                     medium,
+                    model,
                     specular,
                 }),
                 texture_key,
@@ -181,19 +195,43 @@ pub(crate) fn build_material(
     }
 }
 
+/// `profile`: one of [`profile_names`]; the classical dipole when absent.
+fn profile_model(c: &Check, key: &str, v: &Option<Spanned<String>>) -> Checked<ProfileModel> {
+    let Some(v) = v else {
+        return Ok(ProfileModel::default());
+    };
+    ProfileModel::ALL
+        .into_iter()
+        .find(|m| m.name() == v.get_ref())
+        .ok_or_else(|| {
+            c.at(
+                SceneErrorKind::UnknownName,
+                key,
+                v,
+                format!(
+                    "unknown profile `{}` (expected one of: {})",
+                    v.get_ref(),
+                    profile_names().collect::<Vec<_>>().join(", ")
+                ),
+            )
+        })
+}
+
 /// The three ways of giving a medium; exactly one must be used. Also returns the first
-/// textured key and whether K_d comes from the OBJ's `.mtl` (`kd = "mtl"`).
+/// textured key and whether K_d comes from the OBJ's `.mtl` (`kd = "mtl"`). Every range check
+/// builds the profiles of `model`.
 fn build_medium(
     c: &Check,
     name: &str,
     raw: &Spanned<RawMaterial>,
+    model: ProfileModel,
     textures: &mut TextureCache,
 ) -> Checked<(Medium, Option<&'static str>, bool)> {
     let m = raw.get_ref();
     let key = |k: &str| format!("material.{name}.{k}");
     const FORMS: &str = "a translucent material takes exactly one of: `preset` + `mm_per_unit`; \
-                         `sigma_a` + `sigma_s_prime` + `eta`; `kd` + (`mean_free_path` or \
-                         `diffuse_mean_free_path`) + `eta`";
+                         `sigma_a` + `sigma_s_prime` + `eta`; `kd` + (`mean_free_path`, \
+                         `diffuse_mean_free_path` or `radius` [+ `radius_scale`]) + `eta`";
     // The first key of each form that is present, with its span.
     let preset_form = m.preset.as_ref().map(|v| ("preset", v.span()));
     let coeff_form = m
@@ -217,7 +255,9 @@ fn build_medium(
                 m.diffuse_mean_free_path
                     .as_ref()
                     .map(|v| ("diffuse_mean_free_path", v.span()))
-            });
+            })
+            .or_else(|| m.radius.as_ref().map(|v| ("radius", v.span())))
+            .or_else(|| m.radius_scale.as_ref().map(|v| ("radius_scale", v.span())));
     let present: Vec<_> = [preset_form, coeff_form, artist_form]
         .into_iter()
         .flatten()
@@ -261,7 +301,7 @@ fn build_medium(
         let scale = c.require(&key("mm_per_unit"), &m.mm_per_unit, raw, "a preset")?;
         let mm_per_unit = c.positive(&key("mm_per_unit"), scale)?;
         if let Some(found) = lucent_core::presets::find(preset.get_ref())
-            && let Err(e) = lucent_core::Profile::from_preset(found, mm_per_unit)
+            && let Err(e) = lucent_core::Profile::from_preset_with(model, found, mm_per_unit)
         {
             return Err(c.range(
                 &key("mm_per_unit"),
@@ -293,7 +333,9 @@ fn build_medium(
             "must be greater than 0",
         )?;
         let eta = eta(c, &key("eta"), &m.eta, raw, what)?;
-        if let Err(e) = lucent_core::Profile::from_coefficients(sigma_a, sigma_s_prime, eta) {
+        if let Err(e) =
+            lucent_core::Profile::from_coefficients_with(model, sigma_a, sigma_s_prime, eta)
+        {
             return Err(c.range(
                 &key("sigma_a"),
                 sa,
@@ -320,42 +362,10 @@ fn build_medium(
     } else {
         color_param(c, &key("kd"), kd_raw, textures)?
     };
-    let distance = match (&m.mean_free_path, &m.diffuse_mean_free_path) {
-        (Some(_), Some(d)) => {
-            return Err(c.at(
-                SceneErrorKind::Conflict,
-                &key("diffuse_mean_free_path"),
-                d,
-                "cannot be combined with `mean_free_path`: give one distance",
-            ));
-        }
-        (Some(u), None) => {
-            Distance::MeanFreePath(distance_param(c, &key("mean_free_path"), u, textures)?)
-        }
-        (None, Some(d)) => Distance::DiffuseMeanFreePath(distance_param(
-            c,
-            &key("diffuse_mean_free_path"),
-            d,
-            textures,
-        )?),
-        (None, None) => {
-            return Err(c.at(
-                SceneErrorKind::MissingKey,
-                &key("mean_free_path"),
-                raw,
-                "missing required key: `kd` needs `mean_free_path` (ℓ_u = 1/σ_t′) or \
-                 `diffuse_mean_free_path` (ℓ_d = 1/σ_tr)",
-            ));
-        }
-    };
+    let (distance, given_distance) = distance(c, name, raw, textures)?;
     let eta = eta(c, &key("eta"), &m.eta, raw, what)?;
-    let given_distance = match (&m.mean_free_path, &m.diffuse_mean_free_path) {
-        (Some(u), _) => Some(("mean_free_path", u)),
-        (_, d) => d.as_ref().map(|d| ("diffuse_mean_free_path", d)),
-    };
-    if let Err(e) = crate::material::reflectance_params(&kd, &distance, eta)
-        && let Some((name, v)) = given_distance
-    {
+    if let Err(e) = crate::material::reflectance_params(&kd, &distance, eta, model) {
+        let (name, v) = given_distance;
         return Err(c.at(
             SceneErrorKind::OutOfRange,
             &key(name),
@@ -370,10 +380,8 @@ fn build_medium(
     let textured = [
         (kd_from_mtl || matches!(kd, ColorParam::Texture(_))).then_some("kd"),
         match &distance {
-            Distance::MeanFreePath(ScalarParam::Texture { .. }) => Some("mean_free_path"),
-            Distance::DiffuseMeanFreePath(ScalarParam::Texture { .. }) => {
-                Some("diffuse_mean_free_path")
-            }
+            Distance::MeanFreePath(ScalarParam::Texture { .. })
+            | Distance::DiffuseMeanFreePath(ScalarParam::Texture { .. }) => Some(given_distance.0),
             _ => None,
         },
     ];
@@ -382,6 +390,110 @@ fn build_medium(
         textured.into_iter().flatten().next(),
         kd_from_mtl,
     ))
+}
+
+/// The distance of the artist form: exactly one of `mean_free_path`, `diffuse_mean_free_path`
+/// and `radius` (ℓ_u = `radius` × `radius_scale`, the scale only with `radius`). Also returns
+/// the key it was given by and its value (where a range error on it points).
+fn distance<'r>(
+    c: &Check,
+    name: &str,
+    raw: &'r Spanned<RawMaterial>,
+    textures: &mut TextureCache,
+) -> Checked<(Distance, (&'static str, &'r Spanned<RawParam>))> {
+    let m = raw.get_ref();
+    let key = |k: &str| format!("material.{name}.{k}");
+    let given: Vec<(&'static str, &Spanned<RawParam>)> = [
+        ("mean_free_path", &m.mean_free_path),
+        ("diffuse_mean_free_path", &m.diffuse_mean_free_path),
+        ("radius", &m.radius),
+    ]
+    .into_iter()
+    .filter_map(|(k, v)| v.as_ref().map(|v| (k, v)))
+    .collect();
+    let (which, v) = match given.as_slice() {
+        [] => {
+            return Err(match &m.radius_scale {
+                Some(scale) => c.at(
+                    SceneErrorKind::MissingKey,
+                    &key("radius"),
+                    scale,
+                    "missing required key: `radius_scale` scales `radius`",
+                ),
+                None => c.at(
+                    SceneErrorKind::MissingKey,
+                    &key("mean_free_path"),
+                    raw,
+                    "missing required key: `kd` needs `mean_free_path` (ℓ_u = 1/σ_t′), \
+                     `diffuse_mean_free_path` (ℓ_d = 1/σ_tr) or `radius` (ℓ_u, with \
+                     `radius_scale`)",
+                ),
+            });
+        }
+        [(first, _), (second, v), ..] => {
+            return Err(c.at(
+                SceneErrorKind::Conflict,
+                &key(second),
+                v,
+                format!("cannot be combined with `{first}`: give one distance"),
+            ));
+        }
+        [one] => *one,
+    };
+    if which != "radius"
+        && let Some(scale) = &m.radius_scale
+    {
+        return Err(c.at(
+            SceneErrorKind::Conflict,
+            &key("radius_scale"),
+            scale,
+            format!("cannot be combined with `{which}`: it scales `radius`"),
+        ));
+    }
+    let param = distance_param(c, &key(which), v, textures)?;
+    let distance = match which {
+        "diffuse_mean_free_path" => Distance::DiffuseMeanFreePath(param),
+        "radius" => Distance::MeanFreePath(match &m.radius_scale {
+            None => param,
+            Some(scale) => scaled_radius(c, &key("radius_scale"), scale, param)?,
+        }),
+        _ => Distance::MeanFreePath(param),
+    };
+    Ok((distance, (which, v)))
+}
+
+/// `radius` × `radius_scale` (a positive number), per channel in single precision; the products
+/// must stay positive and finite.
+fn scaled_radius(
+    c: &Check,
+    key: &str,
+    scale: &Spanned<f64>,
+    radius: ScalarParam,
+) -> Checked<ScalarParam> {
+    let s = c.positive(key, scale)?;
+    let product = |r: Vec3| {
+        let l = r * s;
+        if l.is_finite() && l.min_element() > 0.0 {
+            Ok(l)
+        } else {
+            Err(c.range(
+                key,
+                scale,
+                format!(
+                    "{} times radius {r} is not a positive single-precision distance",
+                    c.written(scale)
+                ),
+            ))
+        }
+    };
+    Ok(match radius {
+        ScalarParam::Constant(r) => ScalarParam::Constant(product(r)?),
+        ScalarParam::Texture { texture, min, max } => ScalarParam::Texture {
+            texture,
+            min: product(Vec3::splat(min))?.x,
+            max: product(Vec3::splat(max))?.x,
+        },
+    })
 }
 
 /// The relative index of refraction: required, in [1, `lucent_core::Profile::MAX_ETA`] (the

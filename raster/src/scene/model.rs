@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use lucent_core::Method;
+use lucent_core::{Method, ProfileModel};
 
 use crate::camera::Camera;
 use crate::lights::EnvironmentMap;
@@ -67,7 +67,7 @@ pub struct Mesh {
 /// A surface material.
 #[derive(Clone, Debug)]
 pub enum Material {
-    /// Subsurface scattering through the dipole (shaded by `lucent-core`).
+    /// Subsurface scattering through a diffusion profile (shaded by `lucent-core`).
     Translucent(TranslucentMaterial),
     /// An opaque Lambertian reflector.
     Lambert {
@@ -86,6 +86,9 @@ pub struct TranslucentMaterial {
     pub name: String,
     /// The scattering parameters.
     pub medium: Medium,
+    /// The diffusion model every profile of the material is built with (`profile = …`; the
+    /// classical dipole by default).
+    pub model: ProfileModel,
     /// Fresnel-weighted specular highlight, if enabled.
     pub specular: Option<Specular>,
 }
@@ -124,7 +127,9 @@ pub enum Medium {
 /// Which mean free path a distance parameter means (both are common; see the README).
 #[derive(Clone, Debug)]
 pub enum Distance {
-    /// ℓ_u = 1/σ_t′, the mean free path (N10, pbrt-v3); the one N10 varies by texture.
+    /// ℓ_u = 1/σ_t′, the mean free path (N10, pbrt-v3); the one N10 varies by texture. Also
+    /// what `radius × radius_scale` (Standard Surface's `subsurface_radius`,
+    /// `subsurface_scale`) gives, already multiplied.
     MeanFreePath(ScalarParam),
     /// ℓ_d = 1/σ_tr, the diffuse mean free path (JB02, pbrt-v2's `meanfreepath`).
     DiffuseMeanFreePath(ScalarParam),

@@ -142,7 +142,7 @@ fn targets_corpora_and_properties_agree() {
 fn scene_seeds_are_the_shipped_scenes() {
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
     let seeds = fuzz_dir().join("corpus/scene_parse_never_panics");
-    for name in ["default", "sphere-shadow", "textured-mfp"] {
+    for name in ["default", "sphere-shadow", "textured-mfp", "burley-marble"] {
         let scene = fs::read(scenes.join(format!("{name}.toml"))).expect("shipped scene");
         let seed = fs::read(seeds.join(format!("seed-{name}.toml"))).expect("seed");
         assert!(

@@ -192,6 +192,96 @@ layers = ["local", "depth"]
     );
 }
 
+/// The profile at `uv` of the first material of scene `text` (a translucent one).
+fn profile_at(text: &str, uv: Vec2) -> lucent_core::Profile {
+    let s = load(text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    match crate::material::Shader::new(&s.materials[0]).unwrap() {
+        crate::material::Shader::Translucent(t) => t.at(uv).unwrap().profile,
+        crate::material::Shader::Lambert { .. } => panic!("not translucent:\n{text}"),
+    }
+}
+
+/// `profile` reaches the profile of every way of giving a medium, textured ones included; the
+/// classical dipole without it.
+#[test]
+fn profile_key_reaches_every_profile() {
+    let forms = [
+        PRESET,
+        "sigma_a = 0.1\nsigma_s_prime = 2\neta = 1.3",
+        "kd = [0.8, 0.5, 0.3]\nmean_free_path = 0.2\neta = 1.3",
+        "kd = { texture = 'ramp.png' }\ndiffuse_mean_free_path = 0.2\neta = 1.3",
+        "kd = 0.5\nradius = { texture = 'ramp.png', min = 0.01, max = 1 }\nradius_scale = 0.5\neta = 1.3",
+    ];
+    let uv = Vec2::new(0.3, 0.5);
+    for form in forms {
+        let plain = profile_at(&edit(PRESET, form), uv);
+        assert_eq!(plain.model(), lucent_core::ProfileModel::Dipole, "{form}");
+        for model in lucent_core::ProfileModel::ALL {
+            let text = edit(PRESET, &format!("{form}\nprofile = \"{}\"", model.name()));
+            let s = load(&text).unwrap_or_else(|e| panic!("{e}"));
+            let Material::Translucent(m) = &s.materials[0] else {
+                panic!("not translucent")
+            };
+            assert_eq!(m.model, model);
+            assert_eq!(profile_at(&text, uv).model(), model, "{form}");
+        }
+    }
+}
+
+/// `radius` × `radius_scale` is `mean_free_path`, to the bit, under every model: constants (a
+/// scale of a power of two, and one that rounds) and distance textures (`min` and `max` scaled)
+/// with a textured K_d.
+#[test]
+fn radius_times_scale_is_the_mean_free_path() {
+    let (radius, s) = ([1.0f32, 0.4, 0.2], 0.3f32);
+    let product = radius.map(|r| r * s);
+    let cases = [
+        (
+            "radius = [1.0, 0.4, 0.2]".to_string(),
+            "mean_free_path = [1.0, 0.4, 0.2]".to_string(),
+        ),
+        (
+            "radius = [1.0, 0.4, 0.2]\nradius_scale = 0.25".to_string(),
+            "mean_free_path = [0.25, 0.1, 0.05]".to_string(),
+        ),
+        (
+            "radius = [1.0, 0.4, 0.2]\nradius_scale = 0.3".to_string(),
+            format!(
+                "mean_free_path = [{:?}, {:?}, {:?}]",
+                product[0], product[1], product[2]
+            ),
+        ),
+        (
+            "radius = { texture = 'ramp.png', min = 0.02, max = 2 }\nradius_scale = 0.5"
+                .to_string(),
+            "mean_free_path = { texture = 'ramp.png', min = 0.01, max = 1 }".to_string(),
+        ),
+    ];
+    for model in lucent_core::ProfileModel::ALL {
+        for kd in ["[0.8, 0.5, 0.3]", "{ texture = 'ramp.png' }"] {
+            for (given, want) in &cases {
+                let material = |distance: &str| {
+                    edit(
+                        PRESET,
+                        &format!(
+                            "kd = {kd}\n{distance}\neta = 1.3\nprofile = '{}'",
+                            model.name()
+                        ),
+                    )
+                };
+                for u in [0.05, 0.3, 0.55, 0.9] {
+                    let uv = Vec2::new(u, 0.5);
+                    let (a, b) = (
+                        profile_at(&material(given), uv),
+                        profile_at(&material(want), uv),
+                    );
+                    assert_eq!(a, b, "{} {kd}: {given} vs {want}", model.name());
+                }
+            }
+        }
+    }
+}
+
 /// The scenes shipped in `scenes/`, loaded from disk.
 fn example_scenes() -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");

@@ -80,6 +80,17 @@ fn material_values() {
         coeffs("1e30", "1e30", "1.3") => "sigma_a", "material.m.sigma_a", "1e30 (with sigma_s_prime = 1e30) is out of range";
         artist("0.5", "mean_free_path = 1e-30")
             => "mean_free_path", "material.m.mean_free_path", "1e-30 is out of range with kd = 0.5";
+        artist("0.5", "radius = [1, 0, 1]") => "radius = [", "material.m.radius", "greater than 0";
+        artist("0.5", "radius = 0.7\nradius_scale = 0") => "radius_scale", "material.m.radius_scale", "greater than 0";
+        artist("0.5", "radius = 0.7\nradius_scale = nan") => "radius_scale", "material.m.radius_scale", "finite";
+        artist("0.5", "radius = 1e30\nradius_scale = 1e30")
+            => "radius_scale", "material.m.radius_scale", "not a positive single-precision distance";
+        artist("0.5", "radius = { texture = 'ramp.png', min = 1e-30, max = 1 }\nradius_scale = 1e-20")
+            => "radius_scale", "material.m.radius_scale", "not a positive single-precision distance";
+        artist("0.5", "radius = { texture = 'ramp.png', min = 0, max = 1 }")
+            => "radius = {", "material.m.radius.min", "greater than 0";
+        artist("0.5", "radius = 1e-30\nprofile = 'burley'")
+            => "radius = 1e-30", "material.m.radius", "1e-30 is out of range with kd = 0.5";
     }
 }
 

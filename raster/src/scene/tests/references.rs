@@ -16,6 +16,10 @@ fn unknown_names_list_the_valid_ones() {
         edit("type = \"translucent\"", "type = \"glass\"") => "glass", "material.m.type", "translucent, lambert";
         append("[render]\nmethod = 'fast'\n") => "fast", "render.method", "local-global, edge-aware";
         append(layers) => "layers", "output.layers", "exitance, local, global, irradiance, depth";
+        edit(PRESET, "preset = 'marble'\nmm_per_unit = 10\nprofile = 'jensen'")
+            => "jensen", "material.m.profile", "expected one of: dipole, better-dipole, burley, burley-diffuse";
+        edit(PRESET, "kd = 0.5\nradius = 0.7\neta = 1.3\nprofile = 'Burley'")
+            => "Burley", "material.m.profile", "unknown profile `Burley`";
     }
 }
 
@@ -40,6 +44,11 @@ fn conflicting_keys() {
         "type = \"lambert\"\nalbedo = 0.5\neta = 1",
     );
     let plus = |extra: &str| edit("mm_per_unit = 10", &format!("mm_per_unit = 10\n{extra}"));
+    let artist = |lines: &str| edit(PRESET, &format!("kd = 0.5\n{lines}\neta = 1.3"));
+    let lambert_profile = edit(
+        "type = \"translucent\"\npreset = \"marble\"\nmm_per_unit = 10",
+        "type = \"lambert\"\nalbedo = 0.5\nprofile = 'burley'",
+    );
     expect_all! { SceneErrorKind::Conflict;
         plus("sigma_a = 1") => "sigma_a", "material.m.sigma_a", "preset";
         plus("kd = 0.5") => "kd", "material.m.kd", "preset";
@@ -55,6 +64,18 @@ fn conflicting_keys() {
         edit(PRESET, both) => "diffuse_mean_free_path", "material.m.diffuse_mean_free_path", "mean_free_path";
         edit(PRESET, ranged_kd) => "kd = ", "material.m.kd.min", "colour texture";
         lambert_eta => "eta", "material.m.eta", "lambert";
+        lambert_profile => "profile", "material.m.profile", "lambert";
+        plus("radius = 0.7") => "radius = 0.7", "material.m.radius", "cannot be combined with `preset`";
+        plus("radius_scale = 2") => "radius_scale", "material.m.radius_scale", "preset";
+        edit(PRESET, "sigma_a = 1\nsigma_s_prime = 1\neta = 1.3\nradius = 0.7")
+            => "radius = 0.7", "material.m.radius", "sigma_a";
+        artist("mean_free_path = 1\nradius = 0.7") => "radius = 0.7", "material.m.radius", "cannot be combined with `mean_free_path`";
+        artist("radius = 0.7\ndiffuse_mean_free_path = 1")
+            => "radius = 0.7", "material.m.radius", "cannot be combined with `diffuse_mean_free_path`";
+        artist("mean_free_path = 1\nradius_scale = 2")
+            => "radius_scale", "material.m.radius_scale", "it scales `radius`";
+        artist("diffuse_mean_free_path = 1\nradius_scale = 2")
+            => "radius_scale", "material.m.radius_scale", "`diffuse_mean_free_path`";
     }
 }
 
@@ -68,6 +89,8 @@ fn mesh_files_are_checked() {
     };
     let textured = "kd = { texture = 'ramp.png' }\nmean_free_path = 1\neta = 1.3";
     let no_uvs = obj("nouv.obj").replacen(PRESET, textured, 1);
+    let radius = "kd = 0.5\nradius = { texture = 'ramp.png', min = 0.1, max = 1 }\neta = 1.3";
+    let no_uvs_radius = obj("nouv.obj").replacen(PRESET, radius, 1);
     expect_all! { SceneErrorKind::Io;
         obj("missing.obj") => "missing.obj", "object[0].obj", "cannot read mesh";
     }
@@ -78,6 +101,7 @@ fn mesh_files_are_checked() {
         obj("nan.obj") => "nan.obj", "object[0].obj", "not finite";
         obj("empty.obj") => "empty.obj", "object[0].obj", "no faces";
         no_uvs => "nouv.obj", "object[0].obj", "no texture coordinates";
+        no_uvs_radius => "nouv.obj", "object[0].obj", "`radius`";
     }
     // The same with UVs loads, and so do the shapes (which always have UVs).
     let s = load(&obj("quad.obj").replacen(PRESET, textured, 1)).expect("UVs present");

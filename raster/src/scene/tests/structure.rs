@@ -51,6 +51,11 @@ fn wrong_types() {
         edit("mm_per_unit = 10", "mm_per_unit = [10]") => "[10]", "material.m.mm_per_unit", "invalid type";
         artist("'white'") => "white", "material.m.kd", "a number, an array";
         artist("[0.5, 0.5]") => "kd = [0.5, 0.5]", "material.m.kd", "array of 3";
+        edit("mm_per_unit = 10", "mm_per_unit = 10\nprofile = 2") => "profile", "material.m.profile", "invalid type";
+        edit(PRESET, "kd = 0.5\nradius = 'wide'\neta = 1.3") => "wide", "material.m.radius", "a number, an array";
+        edit(PRESET, "kd = 0.5\nradius = [1, 2]\neta = 1.3") => "[1, 2]", "material.m.radius", "array of 3";
+        edit(PRESET, "kd = 0.5\nradius = 0.7\nradius_scale = [1, 2, 3]\neta = 1.3")
+            => "radius_scale", "material.m.radius_scale", "invalid type";
     }
 }
 
@@ -71,6 +76,10 @@ fn missing_keys() {
         edit(PRESET, coefficients) => "[material.m]", "material.m.eta", "missing required key";
         edit(PRESET, "kd = 0.5\neta = 1.3") => "[material.m]", "material.m.mean_free_path", "diffuse_mean_free_path";
         edit(PRESET, ramp_no_min) => "mean_free_path =", "material.m.mean_free_path.min", "min";
+        edit(PRESET, "kd = 0.5\nradius_scale = 2\neta = 1.3") => "radius_scale", "material.m.radius", "`radius_scale` scales `radius`";
+        edit(PRESET, "kd = 0.5\nradius = { texture = 'ramp.png', min = 1 }\neta = 1.3")
+            => "radius = {", "material.m.radius.max", "max";
+        edit(PRESET, "radius = 0.7\neta = 1.3") => "[material.m]", "material.m.kd", "missing required key";
         edit("intensity = 20\n", "") => "[[light]]", "light[0].intensity", "point light";
         sphere_light => "[[light]]", "light[0].radius", "sphere light";
     }
