@@ -5,6 +5,7 @@
 //! | `default` | the built-in default scene: marble bunny, plate, key and fill light | across the bunny |
 //! | `sphere` | `scenes/sphere-shadow.toml`: a marble sphere (radius 1 cm at (0, 0, 1), plate edge in x = 0) | the great circle x = 0 |
 //! | `textured` | `scenes/textured-mfp.toml`: a slab whose ℓ_u spans two decades (texture) | the line y = 0, across the ramp |
+//! | `sphere-burley` | `sphere` with the marble under normalised diffusion (`profile = "burley"`) | as `sphere` |
 
 use std::borrow::Cow;
 
@@ -23,14 +24,17 @@ pub enum BenchScene {
     Sphere,
     /// The slab with texture-mapped mean free path.
     Textured,
+    /// The sphere with its marble under Christensen & Burley's normalised diffusion.
+    SphereBurley,
 }
 
 impl BenchScene {
     /// Every scene, in report order.
-    pub const ALL: [BenchScene; 3] = [
+    pub const ALL: [BenchScene; 4] = [
         BenchScene::Default,
         BenchScene::Sphere,
         BenchScene::Textured,
+        BenchScene::SphereBurley,
     ];
 
     /// The name used in file names, tables and `--scenes`.
@@ -39,6 +43,7 @@ impl BenchScene {
             BenchScene::Default => "default",
             BenchScene::Sphere => "sphere",
             BenchScene::Textured => "textured",
+            BenchScene::SphereBurley => "sphere-burley",
         }
     }
 
@@ -59,6 +64,13 @@ impl BenchScene {
                     files: Vec::new(),
                 },
             )?,
+            BenchScene::SphereBurley => parse_scene(
+                &with_burley_marble(SPHERE_TOML),
+                &SceneOrigin::Embedded {
+                    name: "<built-in>/sphere-shadow.toml, profile = \"burley\"".to_string(),
+                    files: Vec::new(),
+                },
+            )?,
             BenchScene::Textured => parse_scene(
                 TEXTURED_TOML,
                 &SceneOrigin::Embedded {
@@ -75,6 +87,18 @@ impl BenchScene {
         scene.output = Default::default();
         Ok(scene)
     }
+}
+
+/// The sphere scene's TOML with its marble under normalised diffusion (the searchlight fit):
+/// the same coefficients, so Burley's A is the better dipole's total reflectance of them and
+/// ℓ = 1/σ_t′ (`docs/physics.md` §18).
+fn with_burley_marble(toml: &str) -> String {
+    let table = "[material.marble]\n";
+    let at = toml
+        .find(table)
+        .expect("the sphere scene has [material.marble]")
+        + table.len();
+    format!("{}profile = \"burley\"\n{}", &toml[..at], &toml[at..])
 }
 
 #[cfg(test)]
@@ -99,5 +123,25 @@ mod tests {
             assert_eq!(BenchScene::from_name(s.name()), Some(s));
         }
         assert_eq!(BenchScene::from_name("teapot"), None);
+    }
+
+    #[test]
+    fn the_burley_sphere_is_the_sphere_under_burley() {
+        use lucent_core::{BurleyFit, ProfileModel};
+        let profile_of = |s: BenchScene| {
+            let scene = s.load(16).unwrap();
+            scene
+                .materials
+                .iter()
+                .find_map(|m| match m {
+                    Material::Translucent(t) => Some(t.clone()),
+                    _ => None,
+                })
+                .unwrap()
+        };
+        let plain = profile_of(BenchScene::Sphere);
+        let burley = profile_of(BenchScene::SphereBurley);
+        assert_eq!(plain.model, ProfileModel::Dipole);
+        assert_eq!(burley.model, ProfileModel::Burley(BurleyFit::Searchlight));
     }
 }
