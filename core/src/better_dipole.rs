@@ -131,8 +131,12 @@ pub fn total_reflectance(albedo: f64, eta: f64) -> f64 {
 /// The α′ whose better-dipole Rd_total is `kd` ∈ (0, 1), by bisection in s = √(3(1 − α′))
 /// (64 halvings; Rd_total is monotone, as for the classical dipole).
 pub fn albedo_from_total_reflectance(kd: f64, eta: f64) -> f64 {
-    let boundary = Boundary::new(eta);
-    let total = |s: f64| UnitBetterDipole::new(1.0 - s * s / 3.0, &boundary).total_reflectance();
+    albedo_from_total_reflectance_with(kd, &Boundary::new(eta))
+}
+
+/// [`albedo_from_total_reflectance`] with the η-only constants computed once (for tables).
+pub fn albedo_from_total_reflectance_with(kd: f64, boundary: &Boundary) -> f64 {
+    let total = |s: f64| UnitBetterDipole::new(1.0 - s * s / 3.0, boundary).total_reflectance();
     let (mut lo, mut hi) = (0.0, math::sqrt64(3.0));
     for _ in 0..64 {
         let mid = 0.5 * (lo + hi);

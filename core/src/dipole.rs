@@ -85,14 +85,22 @@ impl AlbedoInverter {
 
     /// Builds the table of `model` for relative index `eta` (≥ 1; callers validate).
     pub fn for_model(model: crate::profile::ProfileModel, eta: f32) -> Self {
-        let s = if let crate::profile::ProfileModel::Burley(_) = model {
+        use crate::profile::ProfileModel;
+        let boundary = crate::better_dipole::Boundary::new(eta as f64);
+        let invert = |kd: f64| match model {
+            ProfileModel::Dipole => albedo_from_total_reflectance(kd, eta as f64),
+            ProfileModel::BetterDipole => {
+                crate::better_dipole::albedo_from_total_reflectance_with(kd, &boundary)
+            }
+            ProfileModel::Burley(_) => kd,
+        };
+        let s = if let ProfileModel::Burley(_) = model {
             alloc::vec::Vec::new()
         } else {
             (0..=Self::SIZE)
                 .map(|i| {
                     let kd = (i as f64 / Self::SIZE as f64).clamp(1e-9, 1.0 - 1e-12);
-                    let albedo = model.albedo_from_total_reflectance(kd, eta as f64);
-                    math::sqrt64(3.0 * (1.0 - albedo)) as f32
+                    math::sqrt64(3.0 * (1.0 - invert(kd))) as f32
                 })
                 .collect()
         };
