@@ -159,6 +159,7 @@ pub struct Dipole {
     /// α′ in double precision: 1 − α′ must stay exact for albedos near 1.
     albedo: f64,
     sigma_t: f32,
+    /// Rd(0), evaluated as [`Dipole::rd`] does (queries plan with it).
     rd_zero: f32,
     rd_total: f32,
 }
@@ -226,16 +227,28 @@ impl Dipole {
         )
     }
 
+    /// [`Dipole::from_albedo_and_extinction`] when Rd_total(α′) is already known: α′ was
+    /// inverted from `rd_total` (a texture's K_d), so Rd_total need not be evaluated again per
+    /// shading point. `rd_total` must be Rd_total(α′, η) to the inversion's accuracy.
+    pub(crate) fn from_total_albedo_and_extinction(
+        rd_total: f64,
+        albedo: f64,
+        sigma_t: f64,
+        eta: f32,
+    ) -> Result<Self, ParamError> {
+        check_eta(eta)?;
+        Self::with_terms(albedo, sigma_t, boundary_term(eta as f64), rd_total)
+    }
+
     /// The same α′ and η with a new σ_t′: what a texture-mapped mean free path changes per
-    /// shading point. Reuses the α′- and η-only terms (the boundary term A and Rd_total, four
-    /// of the six double-precision exponentials of [`Dipole::from_albedo_and_extinction`]);
+    /// shading point. Reuses the α′- and η-only terms (the boundary term A and Rd_total, the
+    /// two double-precision exponentials of [`Dipole::from_albedo_and_extinction`]);
     /// bit-identical to it. `eta` must be the η this dipole was built with (the dipole does
     /// not keep it; a [`crate::Profile`] does), so this stays inside the crate.
     pub(crate) fn with_extinction(&self, sigma_t: f64, eta: f32) -> Result<Self, ParamError> {
         check_eta(eta)?;
-        debug_assert_eq!(
-            self.rd_total,
-            total_reflectance(self.albedo, eta as f64) as f32,
+        debug_assert!(
+            (self.rd_total - total_reflectance(self.albedo, eta as f64) as f32).abs() < 1e-3,
             "with_extinction called with another η than the dipole's"
         );
         Self::with_terms(
@@ -264,9 +277,7 @@ impl Dipole {
         let z_v = z_r * (1.0 + 4.0 * a / 3.0);
         let sigma_tr = sigma_t * math::sqrt64(3.0 * (1.0 - albedo));
         let scale = albedo / (4.0 * core::f64::consts::PI);
-        let term = |z: f64| z * (sigma_tr * z + 1.0) * math::exp64(-sigma_tr * z) / (z * z * z);
-        let rd_zero = scale * (term(z_r) + term(z_v));
-        let d = Dipole {
+        let mut d = Dipole {
             sigma_tr: sigma_tr as f32,
             z_r: z_r as f32,
             z_v: z_v as f32,
@@ -275,9 +286,12 @@ impl Dipole {
             scale: scale as f32,
             albedo,
             sigma_t: sigma_t as f32,
-            rd_zero: rd_zero as f32,
+            rd_zero: 0.0,
             rd_total: rd_total as f32,
         };
+        // In f32, as queries evaluate Rd: one evaluation both checks and stores it (a
+        // texture-mapped material builds a dipole per shading point).
+        d.rd_zero = d.rd(0.0);
         // Both source depths squared must be normal floats with headroom for r² (else Rd(0)
         // overflows or the profile underflows to nothing), and Rd(0) must be finite. `rd`
         // divides by d³, which leaves f32 long before d² does: z_r³ underflows for z_r below
@@ -292,8 +306,7 @@ impl Dipole {
             && ok(d.z_v * d.z_v2)
             && d.z_v2 < 1e30
             && d.rd_zero.is_finite()
-            && d.rd_zero > 0.0
-            && d.rd(0.0).is_finite())
+            && d.rd_zero > 0.0)
         {
             return Err(ParamError::OutOfRange {
                 name: "mean free path",
@@ -442,7 +455,7 @@ impl Dipole {
         L::splat(self.scale) * corrected.max(L::splat(0.0)).min(plain + plain)
     }
 
-    /// Rd(0), the peak of the profile (precomputed in double precision).
+    /// Rd(0), the peak of the profile ([`Dipole::rd`] at r = 0, computed once).
     pub fn rd_zero(&self) -> f32 {
         self.rd_zero
     }
@@ -550,7 +563,18 @@ mod tests {
     fn rd_zero_matches_reference_value() {
         let d = milk_red();
         assert!((d.rd_zero() - 0.5430).abs() < 5e-4, "{}", d.rd_zero());
-        assert!((d.rd(0.0) - d.rd_zero()).abs() / d.rd_zero() < 1e-6);
+        // The sources' closed form at r = 0: α′/(4π) Σ (σ_tr·z + 1)e^(−σ_tr·z)/z².
+        let term = |z: f64| {
+            let s = d.sigma_tr as f64;
+            (s * z + 1.0) * math::exp64(-s * z) / (z * z)
+        };
+        let want =
+            d.albedo / (4.0 * core::f64::consts::PI) * (term(d.z_r as f64) + term(d.z_v as f64));
+        assert!(
+            (d.rd_zero() as f64 - want).abs() / want < 1e-6,
+            "{} {want}",
+            d.rd_zero()
+        );
     }
 
     /// Rd written out independently in f64 straight from the formula (no precomputed terms).

@@ -335,11 +335,40 @@ impl Profile {
         albedo: [f64; 3],
         sigma_t: [f64; 3],
     ) -> Result<Self, ParamError> {
+        self.rebuilt(albedo, sigma_t, None)
+    }
+
+    /// [`Profile::with_albedo_and_extinction`] for albedo parameters inverted from a known total
+    /// reflectance `kd` under this model (a texture's K_d at the shading point): the classical
+    /// dipole takes `kd` as its Rd_total instead of evaluating Rd_total(α′) again (two double
+    /// exponentials per channel; they agree to the inversion's accuracy, 1e-4).
+    pub fn with_reflectance_albedo_and_extinction(
+        &self,
+        kd: Vec3,
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+    ) -> Result<Self, ParamError> {
+        self.rebuilt(albedo, sigma_t, Some(kd))
+    }
+
+    fn rebuilt(
+        &self,
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+        kd: Option<Vec3>,
+    ) -> Result<Self, ParamError> {
         let channels = match &self.channels {
             Channels::Dipole(ch) => Channels::Dipole(try_channels(|c| {
                 // A constant K_d (only ℓ textured) keeps α′: reuse its Rd_total.
                 if albedo[c] == ch[c].albedo() {
                     ch[c].with_extinction(sigma_t[c], self.eta)
+                } else if let Some(kd) = kd {
+                    Dipole::from_total_albedo_and_extinction(
+                        kd[c] as f64,
+                        albedo[c],
+                        sigma_t[c],
+                        self.eta,
+                    )
                 } else {
                     Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], self.eta)
                 }

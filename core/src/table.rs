@@ -242,7 +242,7 @@ impl Segment {
 /// Where an ℓ falls in a table: below ℓ_min, between ℓ_min and the first node (and how far),
 /// beyond the last node, or between nodes k and k + 1 at t = log₂(ℓ/α) − k.
 #[derive(Clone, Copy, Debug)]
-enum Place {
+pub(crate) enum Place {
     Limit,
     Ramp(f32),
     Last,
@@ -440,9 +440,10 @@ impl LocalIntegralTable {
         self.value(c, self.place(ell))
     }
 
-    /// Where ℓ falls in the table (the same for every channel).
+    /// Where ℓ falls in the table (the same for every channel, and for every table of the same
+    /// α and ℓ_min).
     #[inline]
-    fn place(&self, ell: f32) -> Place {
+    pub(crate) fn place(&self, ell: f32) -> Place {
         if !(ell > self.ell_min) || !ell.is_finite() {
             return Place::Limit;
         }
@@ -469,7 +470,7 @@ impl LocalIntegralTable {
 
     /// Channel c's K at `place`.
     #[inline]
-    fn value(&self, c: usize, place: Place) -> f32 {
+    pub(crate) fn value(&self, c: usize, place: Place) -> f32 {
         match place {
             Place::Limit => self.channels[c].limit,
             Place::Last => self.segment(c, K_MAX).k,

@@ -9,8 +9,8 @@
 //! Texture-mapped ℓ with constant K_d is N10's case: the albedo parameter (α′ for the dipoles,
 //! A for Burley) is fixed, so one [`LocalIntegralTable`] (cached at powers of two of ℓ) serves
 //! every point. A texture-mapped K_d also varies the albedo parameter; K then comes from the
-//! core's [`LocalIntegralByKd`], tables at evenly spaced K_d interpolated linearly in K_d per
-//! channel.
+//! core's [`LocalIntegralByKd`], tables at evenly spaced K_d whose K / K_d is interpolated in
+//! K_d per channel.
 //!
 //! A diffuse mean free path ℓ_d is converted to ℓ_u with the classical dipole's relation
 //! ℓ_u = ℓ_d √(3(1 − α′)) whatever the model (as the core's `Distance::DiffuseMeanFreePath`),
@@ -413,6 +413,31 @@ impl TranslucentShader {
         }
     }
 
+    /// The total reflectance K_d and mean free path ℓ_u at texture coordinate `uv`, without
+    /// building the profile there (what [`TranslucentShader::at`] would give as
+    /// `total_reflectance()` and `mean_free_path()`, to the albedo inversion's accuracy): the
+    /// second pass compares them between a pixel's sub-samples.
+    pub fn parameters_at(&self, uv: Vec2) -> [Vec3; 2] {
+        let (base, kd, distance) = match &self.params {
+            Params::Fixed(p) => return [p.total_reflectance(), p.mean_free_path()],
+            Params::Reflectance { base, kd, distance } => (base, kd, distance),
+        };
+        let (total, dipole_albedo) = match kd {
+            KdSource::Constant { dipole_albedo, .. } => (base.total_reflectance(), *dipole_albedo),
+            KdSource::Texture { texture, .. } => {
+                let value = texture
+                    .sample(uv)
+                    .clamp(Vec3::splat(0.001), Vec3::splat(0.999));
+                (value, kd.albedos(value).1)
+            }
+        };
+        let l = match distance {
+            Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, uv),
+        };
+        let sigma_t = extinction(distance, l, dipole_albedo);
+        [total, Vec3::from_array(sigma_t.map(|s| (1.0 / s) as f32))]
+    }
+
     /// The material at texture coordinate `uv` (ignored when nothing is textured).
     pub fn at(&self, uv: Vec2) -> Result<PointMaterial, ParamError> {
         let (base, kd, distance) = match &self.params {
@@ -437,8 +462,12 @@ impl TranslucentShader {
             Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, uv),
         };
         let sigma_t = extinction(distance, l, dipole_albedo);
+        let profile = match kd_value {
+            Some(kd) => base.with_reflectance_albedo_and_extinction(kd, albedo, sigma_t)?,
+            None => base.with_albedo_and_extinction(albedo, sigma_t)?,
+        };
         Ok(PointMaterial {
-            profile: base.with_albedo_and_extinction(albedo, sigma_t)?,
+            profile,
             kd: kd_value,
         })
     }

@@ -229,8 +229,14 @@ fn wrap_axis(coord: f32, n: usize) -> (usize, usize, f32) {
     let x = wrapped * n as f32 - 0.5; // [−0.5, n − 0.5]
     let x0 = x.floor();
     let frac = x - x0;
-    let i0 = (x0 as i64).rem_euclid(n as i64) as usize;
-    let i1 = (i0 + 1) % n;
+    // x0 ∈ [−1, n − 1]: wrap without an integer division (this runs twice per lookup, at every
+    // shading point of a textured material).
+    let i0 = if x0 < 0.0 {
+        n - 1
+    } else {
+        (x0 as usize).min(n - 1)
+    };
+    let i1 = if i0 + 1 == n { 0 } else { i0 + 1 };
     (i0, i1, frac)
 }
 

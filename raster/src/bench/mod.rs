@@ -13,7 +13,9 @@
 //!     sphere:   exhaustive sum at 18.5k samples vs hierarchical at several ε (speed claim)
 //!               peer comparison (peer.rs): one lookup per pixel, one thread, relRMSE against
 //!               the exhaustive sum, CPU per lookup beside pbrt-v2's; one against two threads
-//!     textured: the power-of-two K table against K by quadrature at every pixel
+//!     textured: the power-of-two K table against K by quadrature at every pixel;
+//!               K_d and radius from textures against constants, one thread, interleaved
+//!               rounds (texture_cost.rs): CPU per lookup, and K over K_d by quadrature
 //!     default:  the shipped `lucent` render at 512², written to PNG + EXR, timed end to end
 //! report: report.md, results.csv, overhead.csv, peer.csv, <scene>-error-vs-time.svg,
 //!         <scene>-edge-error-vs-time.svg, <scene>-figure1.png
@@ -46,6 +48,7 @@ mod report;
 mod runner;
 mod scenes;
 mod split;
+mod texture_cost;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -62,6 +65,7 @@ pub use report::{write_csv, write_markdown, write_overhead_csv};
 pub use runner::{MethodSetting, Reference, RunResult};
 pub use scenes::BenchScene;
 pub use split::TermErrors;
+pub use texture_cost::{TextureCost, VERSIONS as TEXTURE_COST_VERSIONS};
 
 use crate::output::{ErrorStats, OutputError, RgbImage, compare, write_exr, write_png};
 use crate::plot::PlotError;
@@ -240,18 +244,18 @@ impl BenchConfig {
     /// A small version that exercises every step in well under a minute (`--quick`).
     pub fn quick() -> Self {
         BenchConfig {
-            resolution: 96,
-            counts: vec![2_000, 8_000],
+            resolution: 64,
+            counts: vec![1_000, 4_000],
             epsilons: vec![0.5],
             split_epsilon: 0.5,
             seeds: vec![1, 2],
             truth_factor: 4,
             truth_method: Method::LocalGlobal,
             truth_epsilon: 0.05,
-            sheet_count: 8_000,
+            sheet_count: 4_000,
             smoothings: vec![1.5, 3.0],
             overhead_rounds: 2,
-            exhaustive_count: 2_000,
+            exhaustive_count: 1_000,
             exhaustive_epsilons: vec![0.05, 0.5],
             end_to_end: false,
             // The Burley sphere takes the sphere's code path with another profile; `--scenes
@@ -433,6 +437,8 @@ pub struct BenchReport {
     pub overhead: Vec<OverheadRow>,
     /// The textured scene's table check.
     pub table: Option<TableCheck>,
+    /// Texture-mapped K_d and radius against constants on the textured slab.
+    pub texture_cost: Option<TextureCost>,
     /// The default scene end to end (render + PNG + EXR).
     pub end_to_end: Option<Duration>,
     /// The peer comparison on the sphere, if run.
@@ -467,6 +473,7 @@ pub fn run(
         splits: Vec::new(),
         overhead: Vec::new(),
         table: None,
+        texture_cost: None,
         end_to_end: None,
         peer: None,
         figure_captions: Vec::new(),
@@ -633,6 +640,32 @@ fn run_scene(
                 &reference,
                 log,
             )?);
+            if config.overhead_rounds > 0 {
+                log(&format!(
+                    "textured: K_d and radius from textures against constants, {} rounds",
+                    config.overhead_rounds
+                ));
+                let setting = MethodSetting {
+                    method: Method::EdgeRefined,
+                    epsilon: config.split_epsilon,
+                };
+                let cost = texture_cost::measure(
+                    &base,
+                    setting,
+                    config.sheet_count,
+                    config.seeds[0],
+                    config.overhead_rounds,
+                )?;
+                log(&format!(
+                    "textured: CPU per lookup {:.2} / {:.2} / {:.2} µs (constant / uniform / varying texture), K table vs quadrature {:.3}% mean, {:.3}% max",
+                    cost.lookup_us[0],
+                    cost.lookup_us[1],
+                    cost.lookup_us[2],
+                    cost.table_mean_relative * 100.0,
+                    cost.table_max_relative * 100.0
+                ));
+                report.texture_cost = Some(cost);
+            }
         }
         BenchScene::Sphere => {
             report.exhaustive = exhaustive_check(config, &base, log)?;

@@ -278,6 +278,39 @@ fn claims(report: &BenchReport) -> String {
             let _ = writeln!(s, "Not run (the textured scene was not selected).");
         }
     }
+    if let Some(c) = &report.texture_cost {
+        let _ = writeln!(
+            s,
+            "\nTexture-mapped K_d and radius on the same slab, {} samples, edge-refined, one thread, {} interleaved rounds from one baked sample set: the slab's K_d and ℓ_u as constants, as uniform textures of the same values (the textured path: texture lookups, K_d inverted per point, K from the tables over K_d), and as varying textures (K_d from `kd-checker.jpg`, ℓ_u from the ramp).\n\n| material | CPU µs / lookup | against constant (median, min … max over rounds) | evaluations / lookup |\n|---|---:|---:|---:|",
+            c.samples, c.rounds
+        );
+        let spreads = [
+            None,
+            Some(c.uniform_vs_constant),
+            Some(c.varying_vs_constant),
+        ];
+        for (i, name) in super::TEXTURE_COST_VERSIONS.iter().enumerate() {
+            let against = spreads[i].map_or("—".to_string(), |r| {
+                format!(
+                    "{:+.1}% ({:+.1} … {:+.1}%)",
+                    r.median * 100.0,
+                    r.min * 100.0,
+                    r.max * 100.0
+                )
+            });
+            let _ = writeln!(
+                s,
+                "| {name} | {:.2} | {against} | {:.1} |",
+                c.lookup_us[i], c.evaluations[i]
+            );
+        }
+        let _ = writeln!(
+            s,
+            "\nThe varying slab with K from the tables against K by quadrature at every shading point (exitance, translucent pixels, per channel): mean relative {:.3}%, max {:.3}%.",
+            c.table_mean_relative * 100.0,
+            c.table_max_relative * 100.0
+        );
+    }
 
     let _ = writeln!(
         s,

@@ -246,7 +246,7 @@ pub struct BenchArgs {
     /// output folder (written by an earlier run).
     #[arg(long)]
     pub replot: bool,
-    /// A small version (96², two sample counts) that finishes in well under a minute.
+    /// A small version (64², two sample counts) that finishes in well under a minute.
     #[arg(long)]
     pub quick: bool,
     /// Run only the peer comparison (sphere, one lookup per pixel, one thread: CPU per lookup

@@ -368,3 +368,110 @@ fn smallest_decay_length_over_textures_is_the_surface_minimum() {
         }
     }
 }
+
+/// Texture-mapped K_d and radius together, every model: K from the tables (interpolated in K_d
+/// between levels and in ℓ between powers of two) against K by quadrature at each point's own
+/// profile, over K_d ∈ [0.05, 0.95] and ℓ_u ∈ [α/32, 8α] (a `radius` texture, already times
+/// `radius_scale` here), off the table levels in both.
+#[test]
+fn textured_albedo_and_radius_interpolate_k_within_half_a_percent() {
+    // 2 texels along u for K_d (each channel its own range), 2 along v for the distance; uv
+    // between the texel centres (0.25 and 0.75) interpolates both continuously.
+    let kd = texture(
+        &[Vec3::new(0.005, 0.2, 0.35), Vec3::new(0.995, 0.8, 0.65)],
+        2,
+    );
+    let radius = texture(&[Vec3::new(1.0, 0.8, 0.6), Vec3::new(0.0, 0.2, 0.4)], 1);
+    let alpha = 0.04;
+    let (lo, hi) = (alpha / 32.0, 8.0 * alpha);
+    for model in ProfileModel::ALL {
+        let shader = translucent_with(
+            model,
+            Medium::Reflectance {
+                kd: ColorParam::Texture(kd.clone()),
+                distance: Distance::MeanFreePath(ScalarParam::Texture {
+                    texture: radius.clone(),
+                    min: lo,
+                    max: hi,
+                }),
+                eta: 1.4,
+            },
+        );
+        let source = shader.local_term(alpha, alpha / 1024.0).unwrap();
+        let mut worst = 0.0f32;
+        let steps = 41;
+        for i in 0..steps {
+            for j in 0..steps {
+                let uv = Vec2::new(
+                    0.25 + 0.5 * i as f32 / (steps - 1) as f32,
+                    0.25 + 0.5 * j as f32 / (steps - 1) as f32,
+                );
+                let point = shader.at(uv).unwrap();
+                let table = source.lookup(&point).k();
+                let exact = source.exact(&point).k();
+                let ell = point.profile.mean_free_path();
+                assert!(
+                    ell.cmpge(Vec3::splat(lo * 0.999)).all()
+                        && ell.cmple(Vec3::splat(hi * 1.001)).all(),
+                    "{ell}"
+                );
+                let rel = ((table - exact) / exact).abs().max_element();
+                assert!(exact.min_element() > 0.0 && rel.is_finite(), "{exact}");
+                worst = worst.max(rel);
+            }
+        }
+        std::println!(
+            "{}: worst relative K error {:.3}%",
+            model.name(),
+            worst * 100.0
+        );
+        assert!(worst < 0.005, "{}: {worst}", model.name());
+    }
+}
+
+/// The second pass's cheap parameters agree with the profile built at the same point, for
+/// textured K_d and either distance, every model.
+#[test]
+fn parameters_at_match_the_profile_at_the_point() {
+    let kd = texture(&[Vec3::new(0.1, 0.5, 0.9), Vec3::new(0.7, 0.3, 0.05)], 2);
+    let ell = texture(&[Vec3::splat(0.2), Vec3::splat(0.9)], 2);
+    for model in ProfileModel::ALL {
+        for diffuse in [false, true] {
+            let param = ScalarParam::Texture {
+                texture: ell.clone(),
+                min: 0.01,
+                max: 2.0,
+            };
+            let shader = translucent_with(
+                model,
+                Medium::Reflectance {
+                    kd: ColorParam::Texture(kd.clone()),
+                    distance: if diffuse {
+                        Distance::DiffuseMeanFreePath(param)
+                    } else {
+                        Distance::MeanFreePath(param)
+                    },
+                    eta: 1.4,
+                },
+            );
+            for u in [0.1, 0.3, 0.62, 0.9] {
+                let uv = Vec2::new(u, 0.5);
+                let profile = shader.at(uv).unwrap().profile;
+                let [total, ell_u] = shader.parameters_at(uv);
+                let close = |a: Vec3, b: Vec3| ((a - b) / b).abs().max_element() < 1e-3;
+                assert!(
+                    close(total, profile.total_reflectance()),
+                    "{} {u}: {total} vs {}",
+                    model.name(),
+                    profile.total_reflectance()
+                );
+                assert!(
+                    close(ell_u, profile.mean_free_path()),
+                    "{} {u}: {ell_u} vs {}",
+                    model.name(),
+                    profile.mean_free_path()
+                );
+            }
+        }
+    }
+}

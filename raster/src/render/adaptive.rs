@@ -403,10 +403,7 @@ impl Shading<'_> {
         let object = key as usize;
         let a = self.attributes(object, c.triangle, sample);
         let material = match self.prep.shader_of(object) {
-            Shader::Translucent(shader) if shader.is_textured() => shader
-                .at(a.uv)
-                .ok()
-                .map(|m| [m.profile.total_reflectance(), m.profile.mean_free_path()]),
+            Shader::Translucent(shader) if shader.is_textured() => Some(shader.parameters_at(a.uv)),
             _ => None,
         };
         let s = Signature {
