@@ -23,7 +23,7 @@
 //! the classical dipole, which the Monte Carlo comparison bears out (`BENCHMARKS.md`,
 //! "Profiles against a Monte Carlo random walk").
 
-use crate::dipole::{MAX_R2, NodeMoments, check_eta};
+use crate::dipole::{self, MAX_R2, NodeMoments, check_eta};
 use crate::error::ParamError;
 use crate::fresnel;
 use crate::lanes::Lanes;
@@ -182,18 +182,8 @@ impl BetterDipole {
         sigma_t: f64,
         boundary: &Boundary,
     ) -> Result<Self, ParamError> {
-        if !(albedo > 0.0 && albedo <= 1.0) {
-            return Err(ParamError::OutOfRange {
-                name: "albedo",
-                value: albedo as f32,
-            });
-        }
-        if !(sigma_t.is_finite() && sigma_t > 0.0) {
-            return Err(ParamError::NotPositive {
-                name: "sigma_t",
-                value: sigma_t as f32,
-            });
-        }
+        dipole::check_albedo(albedo)?;
+        dipole::check_positive_length("sigma_t", sigma_t)?;
         let unit = UnitBetterDipole::new(albedo, boundary);
         let ell = 1.0 / sigma_t;
         // Every length scales with ℓ_u; R with 1/ℓ_u².

@@ -96,18 +96,8 @@ pub struct Burley {
 impl Burley {
     /// From the surface albedo A ∈ (0, 1], the mean free path ℓ (scene units) and the fit.
     pub fn new(albedo: f64, mean_free_path: f64, fit: BurleyFit) -> Result<Self, ParamError> {
-        if !(albedo > 0.0 && albedo <= 1.0) {
-            return Err(ParamError::OutOfRange {
-                name: "albedo",
-                value: albedo as f32,
-            });
-        }
-        if !(mean_free_path.is_finite() && mean_free_path > 0.0) {
-            return Err(ParamError::NotPositive {
-                name: "mean free path",
-                value: mean_free_path as f32,
-            });
-        }
+        crate::dipole::check_albedo(albedo)?;
+        crate::dipole::check_positive_length("mean free path", mean_free_path)?;
         let d = mean_free_path / fit.scale(albedo);
         let scale = albedo / (8.0 * core::f64::consts::PI * d);
         let r2_floor = R2_FLOOR * d * d;

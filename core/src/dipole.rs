@@ -164,6 +164,30 @@ pub struct Dipole {
     rd_total: f32,
 }
 
+/// An albedo parameter in (0, 1] (α′, or Burley's A).
+pub(crate) fn check_albedo(albedo: f64) -> Result<(), ParamError> {
+    if albedo > 0.0 && albedo <= 1.0 {
+        Ok(())
+    } else {
+        Err(ParamError::OutOfRange {
+            name: "albedo",
+            value: albedo as f32,
+        })
+    }
+}
+
+/// A finite, positive double-precision length or inverse length named `name`.
+pub(crate) fn check_positive_length(name: &'static str, v: f64) -> Result<(), ParamError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::NotPositive {
+            name,
+            value: v as f32,
+        })
+    }
+}
+
 fn check_positive(name: &'static str, v: f32) -> Result<(), ParamError> {
     if !v.is_finite() {
         Err(ParamError::NotFinite { name, value: v })
@@ -261,18 +285,8 @@ impl Dipole {
 
     /// The constructor behind both: α′, σ_t′, the boundary term A(η) and Rd_total(α′, η).
     fn with_terms(albedo: f64, sigma_t: f64, a: f64, rd_total: f64) -> Result<Self, ParamError> {
-        if !(albedo > 0.0 && albedo <= 1.0) {
-            return Err(ParamError::OutOfRange {
-                name: "albedo",
-                value: albedo as f32,
-            });
-        }
-        if !(sigma_t.is_finite() && sigma_t > 0.0) {
-            return Err(ParamError::NotPositive {
-                name: "sigma_t",
-                value: sigma_t as f32,
-            });
-        }
+        check_albedo(albedo)?;
+        check_positive_length("sigma_t", sigma_t)?;
         let z_r = 1.0 / sigma_t;
         let z_v = z_r * (1.0 + 4.0 * a / 3.0);
         let sigma_tr = sigma_t * math::sqrt64(3.0 * (1.0 - albedo));
