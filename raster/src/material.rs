@@ -17,7 +17,7 @@
 //! so a model other than the dipole also keeps the dipole's α′ of K_d for that conversion.
 
 use std::fmt;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use glam::{Vec2, Vec3};
 use lucent_core::error::ParamError;
@@ -161,8 +161,8 @@ pub(crate) enum KdSource {
     /// dipole's table when the model is another one (`None`: the model's α′ is the dipole's).
     Texture {
         texture: Arc<Texture>,
-        inverter: AlbedoInverter,
-        dipole: Option<AlbedoInverter>,
+        inverter: Arc<AlbedoInverter>,
+        dipole: Option<Arc<AlbedoInverter>>,
     },
 }
 
@@ -178,7 +178,8 @@ impl KdSource {
             KdSource::Texture {
                 inverter, dipole, ..
             } => {
-                let invert = |t: &AlbedoInverter| [t.albedo(kd.x), t.albedo(kd.y), t.albedo(kd.z)];
+                let invert =
+                    |t: &Arc<AlbedoInverter>| [t.albedo(kd.x), t.albedo(kd.y), t.albedo(kd.z)];
                 let albedo = invert(inverter);
                 (albedo, dipole.as_ref().map_or(albedo, invert))
             }
@@ -194,6 +195,22 @@ fn extinction(distance: &Distance, l: Vec3, dipole_albedo: [f64; 3]) -> [f64; 3]
             std::array::from_fn(|c| (1.0 / l[c] as f64) / (3.0 * (1.0 - dipole_albedo[c])).sqrt())
         }
     }
+}
+
+/// The albedo inverter of `model` at `eta`, built once per process: a table costs about 10 ms,
+/// and a scene's materials are resolved when it is checked and again when it renders.
+fn shared_inverter(model: ProfileModel, eta: f32) -> Arc<AlbedoInverter> {
+    type Inverters = Vec<((ProfileModel, u32), Arc<AlbedoInverter>)>;
+    static INVERTERS: Mutex<Inverters> = Mutex::new(Vec::new());
+    let key = (model, eta.to_bits());
+    // A poisoned lock only means another thread panicked while pushing: the list is intact.
+    let mut built = INVERTERS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, inverter)) = built.iter().find(|(k, _)| *k == key) {
+        return inverter.clone();
+    }
+    let inverter = Arc::new(AlbedoInverter::for_model(model, eta));
+    built.push((key, inverter.clone()));
+    inverter
 }
 
 /// Validates every constant and both ends of every texture range by building profiles of
@@ -247,8 +264,9 @@ pub(crate) fn reflectance_params(
             }
             KdSource::Texture {
                 texture: t.clone(),
-                inverter: AlbedoInverter::for_model(model, eta),
-                dipole: (model != ProfileModel::Dipole).then(|| AlbedoInverter::new(eta)),
+                inverter: shared_inverter(model, eta),
+                dipole: (model != ProfileModel::Dipole)
+                    .then(|| shared_inverter(ProfileModel::Dipole, eta)),
             }
         }
     };

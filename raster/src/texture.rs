@@ -221,13 +221,25 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// ⌊x⌋ of a finite `x` without a call into the C library (the x86-64 baseline has no rounding
+/// instruction, and a texture lookup floors four times): from |x| = 2²³ on every f32 is an
+/// integer.
+#[inline]
+fn floor(x: f32) -> f32 {
+    if !(x.abs() < 8_388_608.0) {
+        return x;
+    }
+    let t = x as i32 as f32;
+    if t > x { t - 1.0 } else { t }
+}
+
 /// Repeat-wraps one texture coordinate: the two texel indices to blend and the weight of the
 /// second. `coord` is in texture units (0 = first edge, 1 = last edge of the image).
 fn wrap_axis(coord: f32, n: usize) -> (usize, usize, f32) {
     let coord = if coord.is_finite() { coord } else { 0.0 };
-    let wrapped = coord - coord.floor(); // [0, 1] (1 only by rounding)
+    let wrapped = coord - floor(coord); // [0, 1] (1 only by rounding)
     let x = wrapped * n as f32 - 0.5; // [−0.5, n − 0.5]
-    let x0 = x.floor();
+    let x0 = floor(x);
     let frac = x - x0;
     // x0 ∈ [−1, n − 1]: wrap without an integer division (this runs twice per lookup, at every
     // shading point of a textured material).

@@ -298,3 +298,40 @@ fn crc32(data: &[u8]) -> u32 {
     }
     !crc
 }
+
+/// The lookup's floor is the standard library's on every kind of finite value.
+#[test]
+fn floor_matches_the_standard_library() {
+    let mut values = vec![
+        0.0,
+        -0.0,
+        0.5,
+        -0.5,
+        1.0,
+        -1.0,
+        0.999_999_94,
+        -0.999_999_94,
+        8_388_607.5,
+        -8_388_607.5,
+        8_388_608.0,
+        -8_388_609.0,
+        1e30,
+        -1e30,
+        f32::MAX,
+        f32::MIN,
+        f32::MIN_POSITIVE,
+        -f32::MIN_POSITIVE,
+    ];
+    let mut state = 0x2545_f491_u32;
+    for _ in 0..100_000 {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        // Every sign and exponent up to 2^40.
+        let bits = (state & 0x803f_ffff) | ((100 + state % 67) << 23);
+        values.push(f32::from_bits(bits));
+    }
+    for x in values {
+        assert_eq!(floor(x), x.floor(), "{x}");
+    }
+}
