@@ -187,6 +187,24 @@ impl KdSource {
     }
 }
 
+/// What a textured point's profile is built from at `uv`: the texture's K_d (clamped; `None`
+/// for a constant K_d), the model's albedo parameters and σ_t′ per channel.
+fn inputs_at(kd: &KdSource, distance: &Distance, uv: Vec2) -> (Option<Vec3>, [f64; 3], [f64; 3]) {
+    let kd_value = match kd {
+        KdSource::Constant { .. } => None,
+        KdSource::Texture { texture, .. } => Some(
+            texture
+                .sample(uv)
+                .clamp(Vec3::splat(0.001), Vec3::splat(0.999)),
+        ),
+    };
+    let (albedo, dipole_albedo) = kd.albedos(kd_value.unwrap_or(Vec3::ZERO));
+    let l = match distance {
+        Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, uv),
+    };
+    (kd_value, albedo, extinction(distance, l, dipole_albedo))
+}
+
 /// σ_t′ per channel from a distance value `l` (ℓ_u, or ℓ_d with the dipole's α′).
 fn extinction(distance: &Distance, l: Vec3, dipole_albedo: [f64; 3]) -> [f64; 3] {
     match distance {
@@ -440,19 +458,8 @@ impl TranslucentShader {
             Params::Fixed(p) => return [p.total_reflectance(), p.mean_free_path()],
             Params::Reflectance { base, kd, distance } => (base, kd, distance),
         };
-        let (total, dipole_albedo) = match kd {
-            KdSource::Constant { dipole_albedo, .. } => (base.total_reflectance(), *dipole_albedo),
-            KdSource::Texture { texture, .. } => {
-                let value = texture
-                    .sample(uv)
-                    .clamp(Vec3::splat(0.001), Vec3::splat(0.999));
-                (value, kd.albedos(value).1)
-            }
-        };
-        let l = match distance {
-            Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, uv),
-        };
-        let sigma_t = extinction(distance, l, dipole_albedo);
+        let (kd_value, _, sigma_t) = inputs_at(kd, distance, uv);
+        let total = kd_value.unwrap_or_else(|| base.total_reflectance());
         [total, Vec3::from_array(sigma_t.map(|s| (1.0 / s) as f32))]
     }
 
@@ -467,19 +474,7 @@ impl TranslucentShader {
             }
             Params::Reflectance { base, kd, distance } => (base, kd, distance),
         };
-        let kd_value = match kd {
-            KdSource::Constant { .. } => None,
-            KdSource::Texture { texture, .. } => Some(
-                texture
-                    .sample(uv)
-                    .clamp(Vec3::splat(0.001), Vec3::splat(0.999)),
-            ),
-        };
-        let (albedo, dipole_albedo) = kd.albedos(kd_value.unwrap_or(Vec3::ZERO));
-        let l = match distance {
-            Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, uv),
-        };
-        let sigma_t = extinction(distance, l, dipole_albedo);
+        let (kd_value, albedo, sigma_t) = inputs_at(kd, distance, uv);
         let profile = match kd_value {
             Some(kd) => base.with_reflectance_albedo_and_extinction(kd, albedo, sigma_t)?,
             None => base.with_albedo_and_extinction(albedo, sigma_t)?,

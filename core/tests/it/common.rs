@@ -68,3 +68,23 @@ pub fn box_samples(n: usize, size: f32, seed: u64) -> Vec<Sample> {
 pub fn rel_err(got: Vec3, want: Vec3) -> f32 {
     ((got - want).abs() / want.abs().max(Vec3::splat(1e-30))).max_element()
 }
+
+/// A square grid of `n × n` samples of spacing `h` centred on the origin, irradiance `e`.
+pub fn plane(n: usize, h: f32, e: Vec3) -> Vec<Sample> {
+    let half = 0.5 * n as f32 * h;
+    let mut samples = Vec::with_capacity(n * n);
+    for i in 0..n {
+        for j in 0..n {
+            samples.push(Sample {
+                position: Vec3::new(
+                    -half + (i as f32 + 0.5) * h,
+                    -half + (j as f32 + 0.5) * h,
+                    0.0,
+                ),
+                area: h * h,
+                irradiance: e,
+            });
+        }
+    }
+    samples
+}

@@ -10,10 +10,10 @@ use lucent_core::internals::{
 use lucent_core::stats::QueryStats;
 use lucent_core::{
     Distance, IrradianceCache, LocalIntegralTable, Method, Profile, ProfileModel, QuerySettings,
-    Sample, ShadingPoint,
+    ShadingPoint,
 };
 
-use crate::common::{Rng, rel_err, sphere_samples, term};
+use crate::common::{Rng, plane, rel_err, sphere_samples, term};
 
 fn profile(model: ProfileModel, ell: f32) -> Profile {
     Profile::from_reflectance_with(
@@ -298,23 +298,9 @@ fn every_model_local_integral_table_matches_the_exact_integral() {
 #[test]
 fn every_model_reproduces_e_times_total_reflectance_on_a_lit_plane() {
     let h = 0.2_f32;
-    let half = 50.0_f32;
     let e = Vec3::new(1.0, 2.0, 0.5);
-    let n = (2.0 * half / h) as i32;
-    let mut samples = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            samples.push(Sample {
-                position: Vec3::new(
-                    -half + (i as f32 + 0.5) * h,
-                    -half + (j as f32 + 0.5) * h,
-                    0.0,
-                ),
-                area: h * h,
-                irradiance: e,
-            });
-        }
-    }
+    // 500 × 500 samples: the plane spans [−50, 50]², 50 mean free paths each way.
+    let samples = plane(500, h, e);
     let cache = IrradianceCache::build(&samples).unwrap();
     let mut rng = Rng(39);
     for model in ProfileModel::ALL {

@@ -30,7 +30,7 @@ use lucent_core::{
     ShadingPoint,
 };
 
-use crate::common::{Rng, sphere_samples, term};
+use crate::common::{Rng, plane, sphere_samples, term};
 
 // ---------------------------------------------------------------------------------------------
 // Shared checks
@@ -202,26 +202,6 @@ fn points_near(samples: &[Sample], stride: usize, seed: u64) -> Vec<ShadingPoint
         });
     }
     out
-}
-
-/// A square grid of `n × n` samples of spacing `h` centred on the origin, irradiance `e`.
-fn plane(n: usize, h: f32, e: Vec3) -> Vec<Sample> {
-    let half = 0.5 * n as f32 * h;
-    let mut samples = Vec::with_capacity(n * n);
-    for i in 0..n {
-        for j in 0..n {
-            samples.push(Sample {
-                position: Vec3::new(
-                    -half + (i as f32 + 0.5) * h,
-                    -half + (j as f32 + 0.5) * h,
-                    0.0,
-                ),
-                area: h * h,
-                irradiance: e,
-            });
-        }
-    }
-    samples
 }
 
 /// ℓ_u values: `per_decade` per decade from 10^lo to 10^hi.
