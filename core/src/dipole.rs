@@ -13,7 +13,7 @@
 
 use crate::error::ParamError;
 use crate::fresnel;
-use crate::lanes::Lanes;
+use crate::lanes::{DefaultLanes, LANES, Lanes};
 use crate::math;
 
 /// Squared distances are clamped to this before evaluation so that d³ overflows to +∞ (and Rd
@@ -119,7 +119,7 @@ impl AlbedoInverter {
             return kd.clamp(0.0, 1.0) as f64;
         }
         let x = kd.clamp(0.0, 1.0) * Self::SIZE as f32;
-        let i = (x as usize).min(Self::SIZE - 1);
+        let i = (x as i32 as usize).min(Self::SIZE - 1); // x ∈ [0, SIZE]: exact
         let t = x - i as f32;
         let s = (self.s[i] + (self.s[i + 1] - self.s[i]) * t) as f64;
         1.0 - s * s / 3.0
@@ -251,47 +251,57 @@ impl Dipole {
         )
     }
 
-    /// [`Dipole::from_albedo_and_extinction`] when Rd_total(α′) is already known: α′ was
-    /// inverted from `rd_total` (a texture's K_d), so Rd_total need not be evaluated again per
-    /// shading point. `rd_total` must be Rd_total(α′, η) to the inversion's accuracy.
-    pub(crate) fn from_total_albedo_and_extinction(
-        rd_total: f64,
+    /// The constructor behind all: α′, σ_t′, the boundary term A(η) and Rd_total(α′, η).
+    fn with_terms(albedo: f64, sigma_t: f64, a: f64, rd_total: f64) -> Result<Self, ParamError> {
+        let d = Self::without_rd_zero(albedo, sigma_t, a, rd_total)?;
+        let [er, ev] = d.rd_zero_exponents().map(math::exp_nonpositive_poly);
+        d.with_rd_zero(er, ev)
+    }
+
+    /// Three channels' [`Dipole::from_albedo_and_extinction`] from terms already known, as a
+    /// texture-mapped material has them per shading point: the boundary term `a` =
+    /// [`boundary_term`] of a validated η (shared) and each channel's `rd_total` =
+    /// Rd_total(α′, η) — exact when only σ_t′ changed, or the texture's K_d that α′ was inverted
+    /// from (to the inversion's accuracy) — which skips Rd_total's two double-precision
+    /// exponentials. The six exponentials of the channels' Rd(0) take one 8-lane evaluation
+    /// (the same bits as one at a time). Errors as the channels built in order would.
+    pub(crate) fn channels_from_known_terms(
+        a: f64,
+        rd_total: [f64; 3],
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+    ) -> Result<[Self; 3], ParamError> {
+        let parts: [Result<Self, ParamError>; 3] =
+            core::array::from_fn(|c| Self::without_rd_zero(albedo[c], sigma_t[c], a, rd_total[c]));
+        let mut exponents = [0.0f32; LANES];
+        for (c, part) in parts.iter().enumerate() {
+            if let Ok(d) = part {
+                exponents[2 * c..2 * c + 2].copy_from_slice(&d.rd_zero_exponents());
+            }
+        }
+        let e = DefaultLanes::load(&exponents).exp_nonpositive().to_array();
+        let [p0, p1, p2] = parts;
+        Ok([
+            p0?.with_rd_zero(e[0], e[1])?,
+            p1?.with_rd_zero(e[2], e[3])?,
+            p2?.with_rd_zero(e[4], e[5])?,
+        ])
+    }
+
+    /// Every term but Rd(0) (left 0), the inputs checked.
+    fn without_rd_zero(
         albedo: f64,
         sigma_t: f64,
-        eta: f32,
+        a: f64,
+        rd_total: f64,
     ) -> Result<Self, ParamError> {
-        check_eta(eta)?;
-        Self::with_terms(albedo, sigma_t, boundary_term(eta as f64), rd_total)
-    }
-
-    /// The same α′ and η with a new σ_t′: what a texture-mapped mean free path changes per
-    /// shading point. Reuses the α′- and η-only terms (the boundary term A and Rd_total, the
-    /// two double-precision exponentials of [`Dipole::from_albedo_and_extinction`]);
-    /// bit-identical to it. `eta` must be the η this dipole was built with (the dipole does
-    /// not keep it; a [`crate::Profile`] does), so this stays inside the crate.
-    pub(crate) fn with_extinction(&self, sigma_t: f64, eta: f32) -> Result<Self, ParamError> {
-        check_eta(eta)?;
-        debug_assert!(
-            (self.rd_total - total_reflectance(self.albedo, eta as f64) as f32).abs() < 1e-3,
-            "with_extinction called with another η than the dipole's"
-        );
-        Self::with_terms(
-            self.albedo,
-            sigma_t,
-            boundary_term(eta as f64),
-            self.rd_total as f64,
-        )
-    }
-
-    /// The constructor behind both: α′, σ_t′, the boundary term A(η) and Rd_total(α′, η).
-    fn with_terms(albedo: f64, sigma_t: f64, a: f64, rd_total: f64) -> Result<Self, ParamError> {
         check_albedo(albedo)?;
         check_positive_length("sigma_t", sigma_t)?;
         let z_r = 1.0 / sigma_t;
         let z_v = z_r * (1.0 + 4.0 * a / 3.0);
         let sigma_tr = sigma_t * math::sqrt64(3.0 * (1.0 - albedo));
         let scale = albedo / (4.0 * core::f64::consts::PI);
-        let mut d = Dipole {
+        Ok(Dipole {
             sigma_tr: sigma_tr as f32,
             z_r: z_r as f32,
             z_v: z_v as f32,
@@ -302,10 +312,24 @@ impl Dipole {
             sigma_t: sigma_t as f32,
             rd_zero: 0.0,
             rd_total: rd_total as f32,
-        };
-        // In f32, as queries evaluate Rd: one evaluation both checks and stores it (a
-        // texture-mapped material builds a dipole per shading point).
-        d.rd_zero = d.rd(0.0);
+        })
+    }
+
+    /// −σ_tr·z_r and −σ_tr·z_v: the exponents of Rd(0)'s two exponentials.
+    fn rd_zero_exponents(&self) -> [f32; 2] {
+        [-(self.sigma_tr * self.z_r), -(self.sigma_tr * self.z_v)]
+    }
+
+    /// Stores Rd(0) = α′/(4π) Σ (σ_tr·z + 1)·e^(−σ_tr·z)/z² over both sources, from the two
+    /// exponentials `er`, `ev` of [`Dipole::rd_zero_exponents`] evaluated as the 8-lane
+    /// evaluation does ([`math::exp_nonpositive_poly`]; libm's `expf` costs about four times as
+    /// much, and a texture-mapped material builds three dipoles per shading point), then checks
+    /// the ranges.
+    fn with_rd_zero(mut self, er: f32, ev: f32) -> Result<Self, ParamError> {
+        let source = |z: f32, z2: f32, e: f32| (self.sigma_tr * z + 1.0) * e / z2;
+        self.rd_zero =
+            self.scale * (source(self.z_r, self.z_r2, er) + source(self.z_v, self.z_v2, ev));
+        let d = self;
         // Both source depths squared must be normal floats with headroom for r² (else Rd(0)
         // overflows or the profile underflows to nothing), and Rd(0) must be finite. `rd`
         // divides by d³, which leaves f32 long before d² does: z_r³ underflows for z_r below
@@ -324,7 +348,7 @@ impl Dipole {
         {
             return Err(ParamError::OutOfRange {
                 name: "mean free path",
-                value: z_r as f32,
+                value: d.z_r,
             });
         }
         Ok(d)
@@ -559,17 +583,27 @@ mod tests {
 
     /// The per-shading-point shortcut gives the constructor's bits, and its errors.
     #[test]
-    fn with_extinction_equals_full_construction() {
+    fn known_terms_equal_full_construction() {
         for &(albedo, eta) in &[(0.3, 1.0), (0.9, 1.3), (0.999_9, 1.5), (1.0, 2.0)] {
             let base = Dipole::from_albedo_and_extinction(albedo, 1.0, eta).unwrap();
-            for sigma_t in [1e-3, 0.37, 1.0, 25.0, 4e3] {
-                let fast = base.with_extinction(sigma_t, eta).unwrap();
-                let full = Dipole::from_albedo_and_extinction(albedo, sigma_t, eta).unwrap();
-                assert_eq!(alloc::format!("{fast:?}"), alloc::format!("{full:?}"));
+            let a = boundary_term(eta as f64);
+            let rd_total = [base.total_reflectance() as f64; 3];
+            let shortcut = |sigma_t: [f64; 3]| {
+                Dipole::channels_from_known_terms(a, rd_total, [albedo; 3], sigma_t)
+            };
+            let sigma_t = [1e-3, 0.37, 1.0, 25.0, 4e3];
+            for window in sigma_t.windows(3) {
+                let fast = shortcut([window[0], window[1], window[2]]).unwrap();
+                for (c, fast) in fast.iter().enumerate() {
+                    let full = Dipole::from_albedo_and_extinction(albedo, window[c], eta).unwrap();
+                    assert_eq!(alloc::format!("{fast:?}"), alloc::format!("{full:?}"));
+                }
             }
-            assert!(base.with_extinction(f64::NAN, eta).is_err());
-            assert!(base.with_extinction(-1.0, eta).is_err());
-            assert!(base.with_extinction(1e-30, eta).is_err());
+            for bad in [f64::NAN, -1.0, 1e-30] {
+                let err = shortcut([1.0, bad, 1.0]).unwrap_err();
+                let one = Dipole::from_albedo_and_extinction(albedo, bad, eta).unwrap_err();
+                assert_eq!(alloc::format!("{err:?}"), alloc::format!("{one:?}"));
+            }
         }
     }
 

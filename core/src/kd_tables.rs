@@ -23,13 +23,16 @@
 //! within 0.12% for every model (the renderer's test
 //! `textured_albedo_and_radius_interpolate_k_within_half_a_percent`).
 
+use alloc::sync::Arc;
 use alloc::vec::Vec;
 
 use glam::Vec3;
 
 use crate::error::ParamError;
+use crate::lanes::{DefaultLanes, LANES, Lanes};
 use crate::local_term::LocalTerm;
 use crate::profile::{Distance, Profile, ProfileModel};
+use crate::quadrature::GaussLegendre;
 use crate::table::LocalIntegralTable;
 
 /// Local-integral tables at evenly spaced K_d for one η and smoothing radius α, for a material
@@ -39,8 +42,19 @@ use crate::table::LocalIntegralTable;
 pub struct LocalIntegralByKd {
     /// `levels[i]`: the table for K_d = i / LEVELS, clamped into [0.001, 0.999].
     levels: Vec<LocalIntegralTable>,
+    /// `weights[i]`: interval i's reciprocals, so that a lookup divides by nothing.
+    weights: Vec<LevelWeights>,
     alpha: f32,
     ell_min: f32,
+}
+
+/// The interval between levels i and i + 1: K_d,i, 1/K_d,i, 1/K_d,i+1 and 1/(K_d,i+1 − K_d,i).
+#[derive(Clone, Copy, Debug, Default)]
+struct LevelWeights {
+    kd_lo: f32,
+    inv_kd_lo: f32,
+    inv_kd_hi: f32,
+    inv_width: f32,
 }
 
 impl LocalIntegralByKd {
@@ -62,6 +76,7 @@ impl LocalIntegralByKd {
         alpha: f32,
         ell_min: f32,
     ) -> Result<Self, ParamError> {
+        let rule = Arc::new(GaussLegendre::new());
         let levels = (0..=Self::LEVELS)
             .map(|i| {
                 let kd = level_kd(i);
@@ -72,11 +87,23 @@ impl LocalIntegralByKd {
                     Distance::MeanFreePath(Vec3::ONE),
                     eta,
                 )?;
-                LocalIntegralTable::new(&profile, alpha, ell_min)
+                LocalIntegralTable::with_rule(&profile, alpha, ell_min, rule.clone())
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let weights = (0..Self::LEVELS)
+            .map(|i| {
+                let (kd_lo, kd_hi) = (level_kd(i), level_kd(i + 1));
+                LevelWeights {
+                    kd_lo,
+                    inv_kd_lo: 1.0 / kd_lo,
+                    inv_kd_hi: 1.0 / kd_hi,
+                    inv_width: 1.0 / (kd_hi - kd_lo),
+                }
+            })
+            .collect();
         Ok(LocalIntegralByKd {
             levels,
+            weights,
             alpha,
             ell_min,
         })
@@ -102,23 +129,38 @@ impl LocalIntegralByKd {
     /// free path `ell_u`: each channel's two bracketing levels looked up at that channel's ℓ
     /// and interpolated linearly in K_d.
     pub fn lookup(&self, kd: Vec3, ell_u: Vec3) -> Vec3 {
-        let mut k = Vec3::ZERO;
+        // ℓ's place is the same in every table (one α and ℓ_min), and usually in every channel.
+        let first = &self.levels[0];
+        let shared = first.place(ell_u.x);
+        let grey = ell_u.x == ell_u.y && ell_u.y == ell_u.z;
+        // Per channel, the two levels' K = k·e^x: the six exponentials in one 8-lane
+        // evaluation.
+        let mut factors = [0.0f32; 6];
+        let mut exponents = [0.0f32; LANES];
+        let mut interval = [(0.0f32, LevelWeights::default()); 3];
         for c in 0..3 {
-            // NaN stays NaN through the clamps: level 0, and a NaN K.
+            let place = if grey || c == 0 {
+                shared
+            } else {
+                first.place(ell_u[c])
+            };
             let kd_c = kd[c].clamp(LEVEL_KD_MIN, LEVEL_KD_MAX);
-            let i = ((kd_c * Self::LEVELS as f32) as usize).min(Self::LEVELS - 1);
-            // The end levels sit at the clamp bounds, not at 0 and 1: t from the levels' own K_d.
-            let (kd_lo, kd_hi) = (level_kd(i), level_kd(i + 1));
-            let t = ((kd_c - kd_lo) / (kd_hi - kd_lo)).clamp(0.0, 1.0);
-            // The fraction K / K_d is what varies slowly: at low K_d, K is nearly proportional
-            // to K_d and linear interpolation of K itself erred by 2.7% at K_d = 0.005.
-            // Every level has the same α and ℓ_min, so ℓ falls at the same place in each.
-            let place = self.levels[i].place(ell_u[c]);
-            let lo = self.levels[i].value(c, place) / kd_lo;
-            let hi = self.levels[i + 1].value(c, place) / kd_hi;
-            k[c] = (lo + (hi - lo) * t) * kd_c;
+            // In [0.064, 63.94]: the i32 conversion is exact and cheaper than usize's.
+            let i = ((kd_c * Self::LEVELS as f32) as i32 as usize).min(Self::LEVELS - 1);
+            // Every level's profile is grey: channel 0 of its table serves all three (and
+            // only one channel's segments are ever computed).
+            (factors[2 * c], exponents[2 * c]) = self.levels[i].value_parts(0, place);
+            (factors[2 * c + 1], exponents[2 * c + 1]) = self.levels[i + 1].value_parts(0, place);
+            interval[c] = (kd_c, self.weights[i]);
         }
-        k
+        let e = DefaultLanes::load(&exponents).exp_nonpositive().to_array();
+        Vec3::from_array(core::array::from_fn(|c| {
+            let (kd_c, w) = interval[c];
+            let t = ((kd_c - w.kd_lo) * w.inv_width).clamp(0.0, 1.0);
+            let lo = factors[2 * c] * e[2 * c] * w.inv_kd_lo;
+            let hi = factors[2 * c + 1] * e[2 * c + 1] * w.inv_kd_hi;
+            (lo + (hi - lo) * t) * kd_c
+        }))
     }
 
     /// [`LocalIntegralByKd::lookup`] bound to this α: the local term of a query

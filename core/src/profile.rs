@@ -358,21 +358,23 @@ impl Profile {
         kd: Option<Vec3>,
     ) -> Result<Self, ParamError> {
         let channels = match &self.channels {
-            Channels::Dipole(ch) => Channels::Dipole(try_channels(|c| {
-                // A constant K_d (only ℓ textured) keeps α′: reuse its Rd_total.
-                if albedo[c] == ch[c].albedo() {
-                    ch[c].with_extinction(sigma_t[c], self.eta)
-                } else if let Some(kd) = kd {
-                    Dipole::from_total_albedo_and_extinction(
-                        kd[c] as f64,
-                        albedo[c],
-                        sigma_t[c],
-                        self.eta,
-                    )
-                } else {
-                    Dipole::from_albedo_and_extinction(albedo[c], sigma_t[c], self.eta)
-                }
-            })?),
+            Channels::Dipole(ch) => {
+                // η was validated when this profile was built: A(η) once for three channels.
+                let a = dipole::boundary_term(self.eta as f64);
+                let rd_total = core::array::from_fn(|c| {
+                    // A constant K_d (only ℓ textured) keeps α′: reuse its Rd_total.
+                    if albedo[c] == ch[c].albedo() {
+                        ch[c].total_reflectance() as f64
+                    } else if let Some(kd) = kd {
+                        kd[c] as f64
+                    } else {
+                        dipole::total_reflectance(albedo[c], self.eta as f64)
+                    }
+                });
+                Channels::Dipole(Dipole::channels_from_known_terms(
+                    a, rd_total, albedo, sigma_t,
+                )?)
+            }
             Channels::BetterDipole(_, boundary) => Channels::BetterDipole(
                 try_channels(|c| BetterDipole::with_boundary(albedo[c], sigma_t[c], boundary))?,
                 *boundary,

@@ -344,35 +344,64 @@ impl IrradianceCache {
         local: LocalTerm,
         settings: &QuerySettings,
     ) -> Result<QueryPlan, QueryError> {
-        let alpha = local.alpha();
-        if !(alpha.is_finite() && alpha >= 0.0) {
-            return Err(QueryError::InvalidLocalIntegral);
-        }
-        if !non_negative(local.k()) {
-            return Err(QueryError::InvalidLocalIntegral);
-        }
+        check_local(local)?;
         settings.validate()?;
-        let profile = &profile.for_sample_area(self.mean_area());
         // N10's sums are scaled by powers of two near 1/Rd(0) and 1/Ā (see `Params`).
-        let rd_zero = profile.rd_zero().to_array();
-        let rd_scale = rd_zero.map(reciprocal_pow2);
         let area_scale = reciprocal_pow2(self.mean_area());
         let flux_scale = pow2_clamped(f64::from(area_scale) * f64::from(FLUX_HEADROOM));
-        Ok(QueryPlan {
-            profile: *profile,
+        let params = Params {
+            epsilon: settings.epsilon,
+            cull_tolerance: settings.cull_tolerance,
+            kernel: Kernel::new(local.alpha()),
+            irradiance: Vec3::ZERO,
+            rd_scale: [1.0; 3],
+            area_scale,
+            flux_scale,
+        };
+        Ok(self.plan_material(params, settings.method, profile, local))
+    }
+
+    /// The plan of another material (`profile`, `local`) with the settings `plan` was made
+    /// with, on the cache it was made on (this one): for a material that varies over the
+    /// surface, only what depends on the material is redone at each shading point — the
+    /// settings were checked and the cache's scales computed when `plan` was made, and the
+    /// kernel is kept when α is the same. Checks `local` as [`IrradianceCache::plan`] does and
+    /// gives the plan it would give, bit for bit.
+    pub fn replan(
+        &self,
+        plan: &QueryPlan,
+        profile: &Profile,
+        local: LocalTerm,
+    ) -> Result<QueryPlan, QueryError> {
+        check_local(local)?;
+        let mut params = plan.params;
+        if local.alpha().to_bits() != plan.local.alpha().to_bits() {
+            params.kernel = Kernel::new(local.alpha());
+        }
+        Ok(self.plan_material(params, plan.method, profile, local))
+    }
+
+    /// A plan from the settings' and the cache's part (`params`) and the material.
+    #[inline]
+    fn plan_material(
+        &self,
+        params: Params,
+        method: Method,
+        profile: &Profile,
+        local: LocalTerm,
+    ) -> QueryPlan {
+        let profile = profile.for_sample_area(self.mean_area());
+        let rd_zero = profile.rd_zero().to_array();
+        QueryPlan {
+            profile,
             local,
-            method: settings.method,
+            method,
             rd_zero,
             params: Params {
-                epsilon: settings.epsilon,
-                cull_tolerance: settings.cull_tolerance,
-                kernel: Kernel::new(alpha),
-                irradiance: Vec3::ZERO,
-                rd_scale,
-                area_scale,
-                flux_scale,
+                rd_scale: rd_zero.map(reciprocal_pow2),
+                ..params
             },
-        })
+        }
     }
 
     /// [`IrradianceCache::query_with_stats`] with the material's work done once
@@ -480,6 +509,15 @@ impl QueryPlan {
     pub fn profile(&self) -> &Profile {
         &self.profile
     }
+}
+
+/// The local term's checks: α finite and non-negative, K finite and non-negative.
+fn check_local(local: LocalTerm) -> Result<(), QueryError> {
+    let alpha = local.alpha();
+    if !(alpha.is_finite() && alpha >= 0.0 && non_negative(local.k())) {
+        return Err(QueryError::InvalidLocalIntegral);
+    }
+    Ok(())
 }
 
 /// The per-point checks: a finite position, a finite non-negative irradiance.

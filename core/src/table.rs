@@ -63,6 +63,7 @@
 //! quadrature is deterministic), so each word read is either empty or final, and no lock is
 //! needed on any path. [`LocalIntegralTable::prefill`] fills a declared range up front.
 
+use alloc::sync::Arc;
 use alloc::vec::Vec;
 use core::sync::atomic::{AtomicU64, Ordering};
 
@@ -104,10 +105,19 @@ pub fn local_integral_slope_unit<U: UnitShape + ?Sized>(shape: &U, a: f64) -> f6
 /// integrands share Rd_1(ρ), which is most of the cost. K is the same bits whether or not the
 /// slope is wanted (the table's nodes must equal [`local_integral_unit`] exactly).
 pub fn local_integral_and_slope_unit<U: UnitShape + ?Sized>(shape: &U, a: f64) -> (f64, f64) {
+    local_integral_and_slope_with_rule(shape, a, &GaussLegendre::new())
+}
+
+/// [`local_integral_and_slope_unit`] with its 32-point rule built by the caller (once per
+/// table rather than once per node).
+pub(crate) fn local_integral_and_slope_with_rule<U: UnitShape + ?Sized>(
+    shape: &U,
+    a: f64,
+    rule: &GaussLegendre<32>,
+) -> (f64, f64) {
     if !(a > 0.0) {
         return (0.0, 0.0);
     }
-    let rule = GaussLegendre::<32>::new();
     let f = |rho: f64| {
         let common = shape.ring_density(rho);
         let u = rho / a;
@@ -216,11 +226,27 @@ impl Segment {
         if self.c1.is_nan() {
             self.k * (1.0 - t)
         } else {
-            // t·c₁ + t²·(c₂ + t·c₃): a shorter dependency chain than Horner's (t² and t·c₁
-            // in parallel); still exactly 0 at t = 0.
-            let t2 = t * t;
-            self.k * math::exp_nonpositive_poly(t * self.c1 + t2 * (self.c2 + t * self.c3))
+            self.k * math::exp_nonpositive_poly(self.exponent(t))
         }
+    }
+
+    /// [`Segment::at`] as (k, x) with K = k·e^x, x ≤ 0 (x = 0 on a linear segment, and
+    /// e^0 = 1 exactly): for callers that evaluate several exponentials at once.
+    #[inline(always)]
+    fn at_parts(self, t: f32) -> (f32, f32) {
+        if self.c1.is_nan() {
+            (self.k * (1.0 - t), 0.0)
+        } else {
+            (self.k, self.exponent(t))
+        }
+    }
+
+    /// Δ(t) = t·c₁ + t²·(c₂ + t·c₃): a shorter dependency chain than Horner's (t² and t·c₁ in
+    /// parallel); still exactly 0 at t = 0.
+    #[inline(always)]
+    fn exponent(self, t: f32) -> f32 {
+        let t2 = t * t;
+        t * self.c1 + t2 * (self.c2 + t * self.c3)
     }
 
     fn to_bits(self) -> [u64; 2] {
@@ -262,6 +288,8 @@ pub struct LocalIntegralTable {
     /// `entries[k − k_lo][c]` = the two words of the [`Segment`] from ℓ = α·2^k to α·2^(k+1)
     /// for channel c, each `EMPTY` until computed.
     entries: Vec<[[AtomicU64; 2]; 3]>,
+    /// The quadrature rule of the nodes, built once (shared by a set of tables).
+    rule: Arc<GaussLegendre<32>>,
 }
 
 impl LocalIntegralTable {
@@ -269,6 +297,17 @@ impl LocalIntegralTable {
     /// varies), smoothing radius `alpha` (scene units), and threshold `ell_min` (scene units;
     /// below it the ℓ → 0 limit Rd_total is used). Nothing is computed yet.
     pub fn new(profile: &Profile, alpha: f32, ell_min: f32) -> Result<Self, ParamError> {
+        Self::with_rule(profile, alpha, ell_min, Arc::new(GaussLegendre::new()))
+    }
+
+    /// [`LocalIntegralTable::new`] with the nodes' quadrature rule (the same for every table:
+    /// a set of tables builds it once).
+    pub(crate) fn with_rule(
+        profile: &Profile,
+        alpha: f32,
+        ell_min: f32,
+        rule: Arc<GaussLegendre<32>>,
+    ) -> Result<Self, ParamError> {
         crate::local_term::check_smoothing_radius(alpha)?;
         if !ell_min.is_finite() {
             return Err(ParamError::NotFinite {
@@ -306,6 +345,7 @@ impl LocalIntegralTable {
             ratio_min,
             k_lo,
             entries,
+            rule,
         })
     }
 
@@ -349,7 +389,7 @@ impl LocalIntegralTable {
     fn exact_channel(&self, c: usize, ell: f32) -> f32 {
         self.channels[c]
             .unit
-            .local_integral_and_slope(self.alpha as f64 / ell as f64)
+            .local_integral_and_slope_with(self.alpha as f64 / ell as f64, &self.rule)
             .0 as f32
     }
 
@@ -380,7 +420,7 @@ impl LocalIntegralTable {
     fn fill(&self, slots: &[AtomicU64; 2], c: usize, k: i32) -> Segment {
         let unit = &self.channels[c].unit;
         let node = |k: i32| {
-            let (v, a_dk_da) = unit.local_integral_and_slope(math::pow2i64(-k));
+            let (v, a_dk_da) = unit.local_integral_and_slope_with(math::pow2i64(-k), &self.rule);
             // d ln K / d log₂ ℓ = −ln 2 · a·(dK/da) / K.
             let slope = if v > 0.0 {
                 -core::f64::consts::LN_2 * a_dk_da / v
@@ -479,6 +519,17 @@ impl LocalIntegralTable {
                 limit + (self.segment(c, self.k_lo).k - limit) * t
             }
             Place::Between { k, t } => self.segment(c, k).at(t),
+        }
+    }
+
+    /// [`LocalIntegralTable::value`] as (k, x) with K = k·e^x bit for bit when e^x is
+    /// [`math::exp_nonpositive_poly`] (or its 8-lane version): x = 0 where no exponential is
+    /// needed.
+    #[inline]
+    pub(crate) fn value_parts(&self, c: usize, place: Place) -> (f32, f32) {
+        match place {
+            Place::Between { k, t } => self.segment(c, k).at_parts(t),
+            other => (self.value(c, other), 0.0),
         }
     }
 

@@ -7,6 +7,7 @@ use crate::better_dipole::{Boundary, UnitBetterDipole};
 use crate::burley::UnitBurley;
 use crate::dipole::UnitDipole;
 use crate::profile::ProfileModel;
+use crate::quadrature::GaussLegendre;
 
 /// A radial profile with ℓ_u = 1, for quadratures.
 pub trait UnitShape {
@@ -76,9 +77,20 @@ impl UnitProfile {
     /// (K, a·dK/da) at a = α/ℓ_u: N10's local integral and its slope, in closed form for
     /// Burley, else by the table's quadrature ([`crate::table::local_integral_and_slope_unit`]).
     pub fn local_integral_and_slope(&self, a: f64) -> (f64, f64) {
+        self.local_integral_and_slope_with(a, &GaussLegendre::new())
+    }
+
+    /// [`UnitProfile::local_integral_and_slope`] with the quadrature's rule already built (its
+    /// nodes cost about as much as the integral itself; the tables keep one).
+    pub(crate) fn local_integral_and_slope_with(
+        &self,
+        a: f64,
+        rule: &GaussLegendre<32>,
+    ) -> (f64, f64) {
+        use crate::table::local_integral_and_slope_with_rule as quadrature;
         match self {
-            UnitProfile::Dipole(u) => crate::table::local_integral_and_slope_unit(u, a),
-            UnitProfile::BetterDipole(u) => crate::table::local_integral_and_slope_unit(u, a),
+            UnitProfile::Dipole(u) => quadrature(u, a, rule),
+            UnitProfile::BetterDipole(u) => quadrature(u, a, rule),
             UnitProfile::Burley(u) => u.local_integral_and_slope(a),
         }
     }

@@ -237,7 +237,12 @@ fn floor(x: f32) -> f32 {
 /// second. `coord` is in texture units (0 = first edge, 1 = last edge of the image).
 fn wrap_axis(coord: f32, n: usize) -> (usize, usize, f32) {
     let coord = if coord.is_finite() { coord } else { 0.0 };
-    let wrapped = coord - floor(coord); // [0, 1] (1 only by rounding)
+    // [0, 1] (1 only by rounding); most coordinates are already in [0, 1).
+    let wrapped = if (0.0..1.0).contains(&coord) {
+        coord
+    } else {
+        coord - floor(coord)
+    };
     let x = wrapped * n as f32 - 0.5; // [−0.5, n − 0.5]
     let x0 = floor(x);
     let frac = x - x0;
@@ -246,7 +251,9 @@ fn wrap_axis(coord: f32, n: usize) -> (usize, usize, f32) {
     let i0 = if x0 < 0.0 {
         n - 1
     } else {
-        (x0 as usize).min(n - 1)
+        // x0 < n ≤ the decoder's size cap, far below 2³¹: the i32 conversion is exact and
+        // cheaper than usize's.
+        (x0 as i32 as usize).min(n - 1)
     };
     let i1 = if i0 + 1 == n { 0 } else { i0 + 1 };
     (i0, i1, frac)

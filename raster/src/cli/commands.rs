@@ -473,6 +473,10 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
         config.resolution = r;
         config.end_to_end &= r == 512;
     }
+    if let Some(n) = args.rounds {
+        check((1..=100).contains(&n), "--rounds", n, "1 to 100")?;
+        config.overhead_rounds = n;
+    }
     config.threads = args.threads;
     let quiet = args.quiet;
     bench::run(&config, &args.output, &mut |line| {

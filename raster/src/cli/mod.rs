@@ -270,6 +270,10 @@ pub struct BenchArgs {
     /// Image width and height.
     #[arg(long, value_name = "PIXELS")]
     pub resolution: Option<u32>,
+    /// Interleaved rounds of the overhead and texture-cost measurements (default 5, quick 2;
+    /// more narrow their spread on a noisy host).
+    #[arg(long, value_name = "N")]
+    pub rounds: Option<usize>,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,

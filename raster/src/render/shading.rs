@@ -47,6 +47,9 @@ pub struct ObjectCache {
     /// When the material does not vary over the surface: the material, and the query's checks
     /// and constants done once ([`IrradianceCache::plan`]) instead of at every shading point.
     pub uniform: Option<UniformMaterial>,
+    /// When the material varies over the surface: a plan of its base profile, whose settings
+    /// checks and cache scales each shading point reuses ([`IrradianceCache::replan`]).
+    pub textured_plan: Option<QueryPlan>,
 }
 
 /// A material that does not vary over the surface, resolved once for an object.
@@ -102,6 +105,17 @@ impl ObjectCache {
             }
             _ => None,
         };
+        let textured_plan = match shader {
+            Some(shader) if shader.is_textured() => {
+                let base = shader.base_profile();
+                let local = match &local {
+                    Some(_) => LocalTerm::exact(base, alpha).ok(),
+                    None => Some(LocalTerm::NONE),
+                };
+                local.and_then(|local| cache.plan(base, local, settings).ok())
+            }
+            _ => None,
+        };
         Ok(ObjectCache {
             cache,
             alpha,
@@ -109,6 +123,7 @@ impl ObjectCache {
             uniform_k,
             quadrature,
             uniform,
+            textured_plan,
         })
     }
 }
@@ -392,14 +407,27 @@ impl Shading<'_> {
                             (Some(source), None) => source.lookup(point),
                             (None, _) => LocalTerm::NONE,
                         };
-                        let m = super::simd::query(
-                            &oc.cache,
-                            &point.profile,
-                            &shading_point,
-                            local,
-                            &self.settings,
-                            stats,
-                        );
+                        let m = match &oc.textured_plan {
+                            Some(template) => oc
+                                .cache
+                                .replan(template, &point.profile, local)
+                                .and_then(|plan| {
+                                    super::simd::query_planned(
+                                        &oc.cache,
+                                        &plan,
+                                        &shading_point,
+                                        stats,
+                                    )
+                                }),
+                            None => super::simd::query(
+                                &oc.cache,
+                                &point.profile,
+                                &shading_point,
+                                local,
+                                &self.settings,
+                                stats,
+                            ),
+                        };
                         (local, m)
                     }
                 };

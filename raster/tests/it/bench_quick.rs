@@ -244,6 +244,7 @@ fn bench_rejects_bad_options_with_a_message() {
         &["bench", "--quick", "--counts", "5"][..],
         &["bench", "--quick", "--seeds", "0"][..],
         &["bench", "--quick", "--resolution", "3"][..],
+        &["bench", "--quick", "--rounds", "0"][..],
     ] {
         let o = Command::new(env!("CARGO_BIN_EXE_lucent"))
             .args(args)
