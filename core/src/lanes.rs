@@ -327,6 +327,11 @@ mod tests {
             assert!(nan.min(lb).to_array()[i] == b[i] && nan.max(lb).to_array()[i] == b[i]);
             assert!(la.min(nan).to_array()[i].is_nan() && la.max(nan).to_array()[i].is_nan());
             assert_eq!(la.lt(lb).0 >> i & 1 == 1, a[i] < b[i]);
+            assert_eq!(
+                nan.lt(lb).0 | la.lt(nan).0,
+                0,
+                "NaN is never less or greater"
+            );
             let kept = la.keep(Mask(0b1010_0101)).to_array()[i];
             assert_eq!(kept, if 0b1010_0101 >> i & 1 == 1 { a[i] } else { 0.0 });
         }

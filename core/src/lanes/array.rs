@@ -93,11 +93,10 @@ impl Lanes for ArrayLanes {
     }
     #[inline(always)]
     fn lt(self, o: Self) -> Mask {
-        let mut m = 0;
-        for i in 0..LANES {
-            m |= ((self.0[i] < o.0[i]) as u32) << i;
-        }
-        Mask(m)
+        // `wide`'s compare and sign-bit mask (`cmpltps`, `movmskps`): the compiler does not
+        // turn the lane loop into a movemask, and the loop cost about a tenth of a lookup.
+        let (a, b) = (wide::f32x8::from(self.0), wide::f32x8::from(o.0));
+        Mask(a.simd_lt(b).to_bitmask())
     }
     #[inline(always)]
     fn keep(self, m: Mask) -> Self {
