@@ -339,7 +339,7 @@ impl Dipole {
         // must be normal floats, and Rd(0) evaluated in f32 finite.
         // Range tests joined with `&`, not `&&`: seven compares without a branch each (a
         // texture-mapped material checks three dipoles per shading point). NaN fails them all.
-        let normal = |v: f32| (v >= f32::MIN_POSITIVE) & (v <= f32::MAX);
+        let normal = |v: f32| (f32::MIN_POSITIVE..=f32::MAX).contains(&v);
         if !(normal(d.z_r2)
             & normal(d.z_v2)
             & normal(d.z_r * d.z_r2)
