@@ -13,7 +13,7 @@
 
 use crate::error::ParamError;
 use crate::fresnel;
-use crate::lanes::{DefaultLanes, LANES, Lanes};
+use crate::lanes::{LANES, Lanes};
 use crate::math;
 
 /// Squared distances are clamped to this before evaluation so that d³ overflows to +∞ (and Rd
@@ -279,7 +279,7 @@ impl Dipole {
                 exponents[2 * c..2 * c + 2].copy_from_slice(&d.rd_zero_exponents());
             }
         }
-        let e = DefaultLanes::load(&exponents).exp_nonpositive().to_array();
+        let e = math::exp_nonpositive_poly_8(exponents);
         let [p0, p1, p2] = parts;
         Ok([
             p0?.with_rd_zero(e[0], e[1])?,

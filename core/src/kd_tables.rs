@@ -29,8 +29,9 @@ use alloc::vec::Vec;
 use glam::Vec3;
 
 use crate::error::ParamError;
-use crate::lanes::{DefaultLanes, LANES, Lanes};
+use crate::lanes::LANES;
 use crate::local_term::LocalTerm;
+use crate::math;
 use crate::profile::{Distance, Profile, ProfileModel};
 use crate::quadrature::GaussLegendre;
 use crate::table::LocalIntegralTable;
@@ -153,7 +154,7 @@ impl LocalIntegralByKd {
             (factors[2 * c + 1], exponents[2 * c + 1]) = self.levels[i + 1].value_parts(0, place);
             interval[c] = (kd_c, self.weights[i]);
         }
-        let e = DefaultLanes::load(&exponents).exp_nonpositive().to_array();
+        let e = math::exp_nonpositive_poly_8(exponents);
         Vec3::from_array(core::array::from_fn(|c| {
             let (kd_c, w) = interval[c];
             let t = ((kd_c - w.kd_lo) * w.inv_width).clamp(0.0, 1.0);

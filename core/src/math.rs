@@ -184,6 +184,22 @@ mod wide_exp {
 #[cfg(feature = "simd")]
 pub use wide_exp::exp_nonpositive_x8;
 
+/// [`exp_nonpositive_poly`] of eight values at once, bit for bit: the 8-lane version where the
+/// `simd` feature is on, else a loop. For callers that gather several exponentials (a
+/// texture-mapped material's dipoles and K per shading point) and need the scalar path's bits
+/// in every build — the scalar lanes' `exp_nonpositive` is libm's.
+#[inline]
+pub fn exp_nonpositive_poly_8(x: [f32; 8]) -> [f32; 8] {
+    #[cfg(feature = "simd")]
+    {
+        exp_nonpositive_x8(wide::f32x8::from(x)).to_array()
+    }
+    #[cfg(not(feature = "simd"))]
+    {
+        x.map(exp_nonpositive_poly)
+    }
+}
+
 /// One lane of [`exp_nonpositive_x8`], the same operations in the same order, branch-free so
 /// that a loop of eight calls vectorises (the AVX2 traversal's [`crate::lanes::ArrayLanes`]).
 /// 2^n is assembled without a float-to-int conversion: n + (2²³ + 127) is exact (n is an
@@ -213,6 +229,34 @@ pub(crate) fn exp_nonpositive_lane(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Eight at once is the scalar polynomial bit for bit, in either build, NaN and underflow
+    /// included.
+    #[test]
+    fn eight_exponentials_are_the_scalar_ones() {
+        let mut x = -100.0f32;
+        while x <= 0.0 {
+            let v = [
+                x,
+                x * 0.5,
+                x * 0.25,
+                x * 0.1,
+                -0.0,
+                f32::NAN,
+                -87.4,
+                x * 0.01,
+            ];
+            let got = exp_nonpositive_poly_8(v);
+            for (g, &x) in got.iter().zip(&v) {
+                let want = exp_nonpositive_poly(x);
+                assert!(
+                    g.to_bits() == want.to_bits() || (g.is_nan() && want.is_nan()),
+                    "{x}"
+                );
+            }
+            x += 0.37;
+        }
+    }
 
     /// Relative error of the polynomial against libm over the whole range the dipole uses.
     #[test]
