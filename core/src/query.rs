@@ -374,6 +374,11 @@ impl IrradianceCache {
         local: LocalTerm,
     ) -> Result<QueryPlan, QueryError> {
         check_local(local)?;
+        debug_assert_eq!(
+            plan.params.area_scale,
+            reciprocal_pow2(self.mean_area()),
+            "replan with a plan of another cache"
+        );
         let mut params = plan.params;
         if local.alpha().to_bits() != plan.local.alpha().to_bits() {
             params.kernel = Kernel::new(local.alpha());

@@ -269,10 +269,10 @@ impl RadialCdf {
         // Node j = 2m + n: interval m's n-th Gauss node. Rd at all of them, eight at a time as
         // the traversal evaluates it (a textured material builds a quadrature per refined
         // point, and the scalar Rd's libm exponentials cost about six times as much).
-        let t_at = |j: usize| ((j / 2) as f64 + [0.5 - g, 0.5 + g][j % 2]) * h;
+        let nodes = [0.5 - g, 0.5 + g];
+        let t: [f64; NODES] = core::array::from_fn(|j| ((j / 2) as f64 + nodes[j % 2]) * h);
         let r2: [f32; NODES] = core::array::from_fn(|j| {
-            let t = t_at(j);
-            let r = t * t * f64::from(alpha);
+            let r = t[j] * t[j] * f64::from(alpha);
             (r * r) as f32
         });
         let mut rd = [[0.0f32; NODES]; 3];
@@ -285,10 +285,9 @@ impl RadialCdf {
         for m in 0..INTERVALS {
             let mut add = [0.0; 3];
             for j in [2 * m, 2 * m + 1] {
-                let t = t_at(j);
-                let rho = t * t;
+                let rho = t[j] * t[j];
                 // dρ = 2t dt; each Gauss node weighs h/2.
-                let common = rho * Kernel::weight_unit(rho) * 2.0 * t * h * 0.5;
+                let common = rho * Kernel::weight_unit(rho) * 2.0 * t[j] * h * 0.5;
                 for (c, a) in add.iter_mut().enumerate() {
                     *a += common * f64::from(rd[c][j]);
                 }

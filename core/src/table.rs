@@ -223,15 +223,13 @@ impl Segment {
     /// K at t ∈ [0, 1) along the segment.
     #[inline(always)]
     fn at(self, t: f32) -> f32 {
-        if self.c1.is_nan() {
-            self.k * (1.0 - t)
-        } else {
-            self.k * math::exp_nonpositive_poly(self.exponent(t))
-        }
+        let (k, x) = self.at_parts(t);
+        k * math::exp_nonpositive_poly(x)
     }
 
     /// [`Segment::at`] as (k, x) with K = k·e^x, x ≤ 0 (x = 0 on a linear segment, and
-    /// e^0 = 1 exactly): for callers that evaluate several exponentials at once.
+    /// e^0 = 1 exactly, so the product is k's bits): for callers that evaluate several
+    /// exponentials at once.
     #[inline(always)]
     fn at_parts(self, t: f32) -> (f32, f32) {
         if self.c1.is_nan() {
