@@ -26,6 +26,12 @@ pub fn boundary_term(eta: f64) -> f64 {
     (1.0 + fdr) / (1.0 - fdr)
 }
 
+/// z_v / z_r = 1 + 4A/3 for the boundary term A: the virtual source's depth in units of the
+/// real one's.
+fn virtual_depth_factor(a: f64) -> f64 {
+    1.0 + 4.0 * a / 3.0
+}
+
 /// Total diffuse reflectance ∫ Rd dA of a semi-infinite medium in closed form (J01 eq. 5 as
 /// written in `docs/physics.md` §2):
 /// Rd_total(α′) = (α′/2)(1 + e^(−(4/3) A √(3(1−α′)))) e^(−√(3(1−α′))).
@@ -253,9 +259,12 @@ impl Dipole {
 
     /// The constructor behind all: α′, σ_t′, the boundary term A(η) and Rd_total(α′, η).
     fn with_terms(albedo: f64, sigma_t: f64, a: f64, rd_total: f64) -> Result<Self, ParamError> {
-        let d = Self::without_rd_zero(albedo, sigma_t, a, rd_total)?;
+        check_albedo(albedo)?;
+        check_positive_length("sigma_t", sigma_t)?;
+        let mut d = Self::without_rd_zero(albedo, sigma_t, virtual_depth_factor(a), rd_total);
         let [er, ev] = d.rd_zero_exponents().map(math::exp_nonpositive_poly);
-        d.with_rd_zero(er, ev)
+        d.set_rd_zero(er, ev);
+        d.checked_ranges()
     }
 
     /// Three channels' [`Dipole::from_albedo_and_extinction`] from terms already known, as a
@@ -264,44 +273,60 @@ impl Dipole {
     /// Rd_total(α′, η) — exact when only σ_t′ changed, or the texture's K_d that α′ was inverted
     /// from (to the inversion's accuracy) — which skips Rd_total's two double-precision
     /// exponentials. The six exponentials of the channels' Rd(0) take one 8-lane evaluation
-    /// (the same bits as one at a time). Errors as the channels built in order would.
-    pub(crate) fn channels_from_known_terms(
+    /// (the same bits as one at a time), and the checks are joined without a branch each; when
+    /// one fails, the channels are built in order for the error the first bad one gives.
+    /// Written into `out` (a profile's own channels: no copy of the three), which is left as
+    /// it was on an error.
+    pub(crate) fn fill_from_known_terms(
+        out: &mut [Self; 3],
         a: f64,
         rd_total: [f64; 3],
         albedo: [f64; 3],
         sigma_t: [f64; 3],
-    ) -> Result<[Self; 3], ParamError> {
-        let parts: [Result<Self, ParamError>; 3] =
-            core::array::from_fn(|c| Self::without_rd_zero(albedo[c], sigma_t[c], a, rd_total[c]));
-        let mut exponents = [0.0f32; LANES];
-        for (c, part) in parts.iter().enumerate() {
-            if let Ok(d) = part {
+    ) -> Result<(), ParamError> {
+        // check_albedo and check_positive_length, NaN failing both.
+        let inputs_valid = (0..3).fold(true, |ok, c| {
+            ok & (albedo[c] > 0.0)
+                & (albedo[c] <= 1.0)
+                & (sigma_t[c] > 0.0)
+                & (sigma_t[c] <= f64::MAX)
+        });
+        if inputs_valid {
+            let factor = virtual_depth_factor(a);
+            let mut d: [Self; 3] = core::array::from_fn(|c| {
+                Self::without_rd_zero(albedo[c], sigma_t[c], factor, rd_total[c])
+            });
+            let mut exponents = [0.0f32; LANES];
+            for (c, d) in d.iter().enumerate() {
                 exponents[2 * c..2 * c + 2].copy_from_slice(&d.rd_zero_exponents());
             }
+            let e = math::exp_nonpositive_poly_8(exponents);
+            for (c, d) in d.iter_mut().enumerate() {
+                d.set_rd_zero(e[2 * c], e[2 * c + 1]);
+            }
+            if d.iter().fold(true, |ok, d| ok & d.ranges_valid()) {
+                *out = d;
+                return Ok(());
+            }
         }
-        let e = math::exp_nonpositive_poly_8(exponents);
-        let [p0, p1, p2] = parts;
-        Ok([
-            p0?.with_rd_zero(e[0], e[1])?,
-            p1?.with_rd_zero(e[2], e[3])?,
-            p2?.with_rd_zero(e[4], e[5])?,
-        ])
+        let channel = |c: usize| Self::with_terms(albedo[c], sigma_t[c], a, rd_total[c]);
+        *out = [channel(0)?, channel(1)?, channel(2)?];
+        Ok(())
     }
 
-    /// Every term but Rd(0) (left 0), the inputs checked.
+    /// Every term but Rd(0) (left 0), from inputs already checked; `virtual_depth_factor` is
+    /// [`virtual_depth_factor`] of the boundary term.
     fn without_rd_zero(
         albedo: f64,
         sigma_t: f64,
-        a: f64,
+        virtual_depth_factor: f64,
         rd_total: f64,
-    ) -> Result<Self, ParamError> {
-        check_albedo(albedo)?;
-        check_positive_length("sigma_t", sigma_t)?;
+    ) -> Self {
         let z_r = 1.0 / sigma_t;
-        let z_v = z_r * (1.0 + 4.0 * a / 3.0);
+        let z_v = z_r * virtual_depth_factor;
         let sigma_tr = sigma_t * math::sqrt64(3.0 * (1.0 - albedo));
         let scale = albedo / (4.0 * core::f64::consts::PI);
-        Ok(Dipole {
+        Dipole {
             sigma_tr: sigma_tr as f32,
             z_r: z_r as f32,
             z_v: z_v as f32,
@@ -312,7 +337,7 @@ impl Dipole {
             sigma_t: sigma_t as f32,
             rd_zero: 0.0,
             rd_total: rd_total as f32,
-        })
+        }
     }
 
     /// −σ_tr·z_r and −σ_tr·z_v: the exponents of Rd(0)'s two exponentials.
@@ -323,37 +348,45 @@ impl Dipole {
     /// Stores Rd(0) = α′/(4π) Σ (σ_tr·z + 1)·e^(−σ_tr·z)/z² over both sources, from the two
     /// exponentials `er`, `ev` of [`Dipole::rd_zero_exponents`] evaluated as the 8-lane
     /// evaluation does ([`math::exp_nonpositive_poly`]; libm's `expf` costs about four times as
-    /// much, and a texture-mapped material builds three dipoles per shading point), then checks
-    /// the ranges.
-    fn with_rd_zero(mut self, er: f32, ev: f32) -> Result<Self, ParamError> {
+    /// much, and a texture-mapped material builds three dipoles per shading point).
+    fn set_rd_zero(&mut self, er: f32, ev: f32) {
         let source = |z: f32, z2: f32, e: f32| (self.sigma_tr * z + 1.0) * e / z2;
         self.rd_zero =
             self.scale * (source(self.z_r, self.z_r2, er) + source(self.z_v, self.z_v2, ev));
-        let d = self;
-        // Both source depths squared must be normal floats with headroom for r² (else Rd(0)
-        // overflows or the profile underflows to nothing), and Rd(0) must be finite. `rd`
-        // divides by d³, which leaves f32 long before d² does: z_r³ underflows for z_r below
-        // ∛MIN_POSITIVE ≈ 2.3e-13 (then Rd(0) = ∞, and (1 − w)·Rd = 0·∞ turns the split
-        // methods' sums into NaN), and z_v³ overflows for z_v above ∛MAX ≈ 7e12 (then the
-        // virtual source's term is 0 at every r and Rd ≡ 0 or is missing a term). Both cubes
-        // must be normal floats, and Rd(0) evaluated in f32 finite.
+    }
+
+    /// Whether the depths and Rd(0) are in the range evaluation needs.
+    ///
+    /// Both source depths squared must be normal floats with headroom for r² (else Rd(0)
+    /// overflows or the profile underflows to nothing), and Rd(0) must be finite. `rd`
+    /// divides by d³, which leaves f32 long before d² does: z_r³ underflows for z_r below
+    /// ∛MIN_POSITIVE ≈ 2.3e-13 (then Rd(0) = ∞, and (1 − w)·Rd = 0·∞ turns the split
+    /// methods' sums into NaN), and z_v³ overflows for z_v above ∛MAX ≈ 7e12 (then the
+    /// virtual source's term is 0 at every r and Rd ≡ 0 or is missing a term). Both cubes
+    /// must be normal floats, and Rd(0) evaluated in f32 finite.
+    fn ranges_valid(&self) -> bool {
         // Range tests joined with `&`, not `&&`: seven compares without a branch each (a
         // texture-mapped material checks three dipoles per shading point). NaN fails them all.
         let normal = |v: f32| (f32::MIN_POSITIVE..=f32::MAX).contains(&v);
-        if !(normal(d.z_r2)
-            & normal(d.z_v2)
-            & normal(d.z_r * d.z_r2)
-            & normal(d.z_v * d.z_v2)
-            & (d.z_v2 < 1e30)
-            & (d.rd_zero > 0.0)
-            & (d.rd_zero <= f32::MAX))
-        {
-            return Err(ParamError::OutOfRange {
+        normal(self.z_r2)
+            & normal(self.z_v2)
+            & normal(self.z_r * self.z_r2)
+            & normal(self.z_v * self.z_v2)
+            & (self.z_v2 < 1e30)
+            & (self.rd_zero > 0.0)
+            & (self.rd_zero <= f32::MAX)
+    }
+
+    /// `self`, or the error of a mean free path out of [`Dipole::ranges_valid`]'s range.
+    fn checked_ranges(self) -> Result<Self, ParamError> {
+        if self.ranges_valid() {
+            Ok(self)
+        } else {
+            Err(ParamError::OutOfRange {
                 name: "mean free path",
-                value: d.z_r,
-            });
+                value: self.z_r,
+            })
         }
-        Ok(d)
     }
 
     /// Rd(r) from r² (units 1/length²).
@@ -591,7 +624,8 @@ mod tests {
             let a = boundary_term(eta as f64);
             let rd_total = [base.total_reflectance() as f64; 3];
             let shortcut = |sigma_t: [f64; 3]| {
-                Dipole::channels_from_known_terms(a, rd_total, [albedo; 3], sigma_t)
+                let mut d = [base; 3];
+                Dipole::fill_from_known_terms(&mut d, a, rd_total, [albedo; 3], sigma_t).map(|()| d)
             };
             let sigma_t = [1e-3, 0.37, 1.0, 25.0, 4e3];
             for window in sigma_t.windows(3) {

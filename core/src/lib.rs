@@ -112,7 +112,7 @@ pub use kd_tables::LocalIntegralByKd;
 pub use local_term::LocalTerm;
 pub use profile::{Distance, Profile, ProfileModel};
 pub use query::{Exitance, Method, QueryPlan, QuerySettings, ShadingPoint};
-pub use refine::LocalQuadrature;
+pub use refine::{LocalQuadrature, QuadratureLayout};
 pub use table::LocalIntegralTable;
 
 /// Implementation details that the renderer, the test suites, the benchmarks and the fuzz

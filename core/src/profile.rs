@@ -357,7 +357,9 @@ impl Profile {
         sigma_t: [f64; 3],
         kd: Option<Vec3>,
     ) -> Result<Self, ParamError> {
-        let channels = match &self.channels {
+        // Built in a copy of this profile, its channels overwritten in place.
+        let mut out = *self;
+        match &mut out.channels {
             Channels::Dipole(ch) => {
                 // η was validated when this profile was built: A(η) once for three channels.
                 let a = dipole::boundary_term(self.eta as f64);
@@ -371,23 +373,23 @@ impl Profile {
                         dipole::total_reflectance(albedo[c], self.eta as f64)
                     }
                 });
-                Channels::Dipole(Dipole::channels_from_known_terms(
-                    a, rd_total, albedo, sigma_t,
-                )?)
+                Dipole::fill_from_known_terms(ch, a, rd_total, albedo, sigma_t)?;
             }
-            Channels::BetterDipole(_, boundary) => Channels::BetterDipole(
-                try_channels(|c| BetterDipole::with_boundary(albedo[c], sigma_t[c], boundary))?,
-                *boundary,
-            ),
-            Channels::Burley(_, fit) => Channels::Burley(
-                try_channels(|c| {
+            Channels::BetterDipole(ch, boundary) => {
+                let boundary = *boundary;
+                *ch = try_channels(|c| {
+                    BetterDipole::with_boundary(albedo[c], sigma_t[c], &boundary)
+                })?;
+            }
+            Channels::Burley(ch, fit) => {
+                let fit = *fit;
+                *ch = try_channels(|c| {
                     check_extinction(sigma_t[c])?;
-                    Burley::new(albedo[c], 1.0 / sigma_t[c], *fit)
-                })?,
-                *fit,
-            ),
-        };
-        Ok(Profile { channels, ..*self })
+                    Burley::new(albedo[c], 1.0 / sigma_t[c], fit)
+                })?;
+            }
+        }
+        Ok(out)
     }
 
     /// The profile as a query on a cache of mean sample area `mean_area` evaluates it: for

@@ -145,17 +145,21 @@ impl LocalQuadrature {
     /// [`LocalQuadrature::MAX_NODES`] by reducing the rings). α = 0 or non-finite gives one
     /// node at x.
     pub fn new(profile: &Profile, alpha: f32, rings: usize, per_ring: usize) -> Self {
-        let per_ring = per_ring.clamp(1, MAX_PER_RING);
-        let rings = rings.clamp(1, MAX_RINGS).min(MAX_NODES / per_ring);
-        let alpha = if alpha.is_finite() && alpha > 0.0 {
-            alpha
-        } else {
-            0.0
-        };
-        let cdf = RadialCdf::new(profile, alpha);
+        Self::with_layout(profile, &QuadratureLayout::new(alpha, rings, per_ring))
+    }
+
+    /// [`LocalQuadrature::new`] with the part that does not depend on the profile done once
+    /// (a texture-mapped material builds a quadrature per refined point); the same bits.
+    pub fn with_layout(profile: &Profile, layout: &QuadratureLayout) -> Self {
+        let QuadratureLayout {
+            alpha,
+            rings,
+            per_ring,
+            ..
+        } = *layout;
+        let cdf = RadialCdf::new(profile, layout);
         let mut fraction = [Vec3::ZERO; MAX_RINGS];
         let mut offset = [Vec2::ZERO; MAX_NODES];
-        let golden = (math::sqrt64(5.0) - 1.0) / 2.0;
         for j in 0..rings {
             let lo = cdf.at_reference_mass(j as f64 / rings as f64);
             let hi = cdf.at_reference_mass((j + 1) as f64 / rings as f64);
@@ -165,9 +169,7 @@ impl LocalQuadrature {
             fraction[j] = Vec3::from(mass.map(|m| m as f32));
             let rho = mid * mid; // t = √ρ
             for k in 0..per_ring {
-                let angle =
-                    2.0 * core::f64::consts::PI * (k as f64 + j as f64 * golden) / per_ring as f64;
-                let (s, c) = math::sin_cos64(angle);
+                let (c, s) = layout.direction[j * per_ring + k];
                 offset[j * per_ring + k] = Vec2::new((c * rho) as f32, (s * rho) as f32) * alpha;
             }
         }
@@ -253,6 +255,73 @@ impl LocalQuadrature {
     }
 }
 
+/// What a [`LocalQuadrature`] is built from besides the profile: α, the node counts (clamped
+/// as [`LocalQuadrature::new`] clamps them), each node's direction on the disc, and the radial
+/// distribution's Gauss nodes (r² at each, and its weight ρ·w(ρ)·dρ). Made once per α and
+/// node counts, it serves every profile ([`LocalQuadrature::with_layout`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct QuadratureLayout {
+    alpha: f32,
+    rings: usize,
+    per_ring: usize,
+    /// (cos, sin) of node j·per_ring + k's angle 2π(k + j·φ)/per_ring.
+    direction: [(f64, f64); MAX_NODES],
+    /// r² = (t²α)² at Gauss node i of the radial distribution (t = √ρ).
+    r2: [f32; NODES],
+    /// ρ·w(ρ)·2t·h/2 at Gauss node i: its weight in the radial mass, Rd aside.
+    weight: [f64; NODES],
+}
+
+impl QuadratureLayout {
+    /// The layout of [`LocalQuadrature::new`]`(_, alpha, rings, per_ring)`.
+    pub fn new(alpha: f32, rings: usize, per_ring: usize) -> Self {
+        let per_ring = per_ring.clamp(1, MAX_PER_RING);
+        let rings = rings.clamp(1, MAX_RINGS).min(MAX_NODES / per_ring);
+        let alpha = if alpha.is_finite() && alpha > 0.0 {
+            alpha
+        } else {
+            0.0
+        };
+        let golden = (math::sqrt64(5.0) - 1.0) / 2.0;
+        let mut direction = [(0.0, 0.0); MAX_NODES];
+        for j in 0..rings {
+            for k in 0..per_ring {
+                let angle =
+                    2.0 * core::f64::consts::PI * (k as f64 + j as f64 * golden) / per_ring as f64;
+                let (s, c) = math::sin_cos64(angle);
+                direction[j * per_ring + k] = (c, s);
+            }
+        }
+        // Node i = 2m + n: interval m's n-th 2-point Gauss–Legendre node on [0, 1].
+        let g = 0.5 / math::sqrt64(3.0);
+        let h = 1.0 / INTERVALS as f64;
+        let nodes = [0.5 - g, 0.5 + g];
+        let t: [f64; NODES] = core::array::from_fn(|i| ((i / 2) as f64 + nodes[i % 2]) * h);
+        let r2 = core::array::from_fn(|i| {
+            let r = t[i] * t[i] * f64::from(alpha);
+            (r * r) as f32
+        });
+        let weight = core::array::from_fn(|i| {
+            let rho = t[i] * t[i];
+            // dρ = 2t dt; each Gauss node weighs h/2.
+            rho * Kernel::weight_unit(rho) * 2.0 * t[i] * h * 0.5
+        });
+        QuadratureLayout {
+            alpha,
+            rings,
+            per_ring,
+            direction,
+            r2,
+            weight,
+        }
+    }
+
+    /// α (0 when the one given was not finite and positive).
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+}
+
 /// The cumulative radial mass of ρ·w(ρ)·Rd(ρα) per channel, at the interval boundaries
 /// t_m = m/32 of t = √ρ, normalised to 1 at ρ = 1.
 struct RadialCdf {
@@ -261,22 +330,13 @@ struct RadialCdf {
 }
 
 impl RadialCdf {
-    fn new(profile: &Profile, alpha: f32) -> Self {
-        // 2-point Gauss–Legendre nodes on [0, 1].
-        let g = 0.5 / math::sqrt64(3.0);
+    fn new(profile: &Profile, layout: &QuadratureLayout) -> Self {
         let mut mass = [[0.0; INTERVALS + 1]; 3];
-        let h = 1.0 / INTERVALS as f64;
-        // Node j = 2m + n: interval m's n-th Gauss node. Rd at all of them, eight at a time as
-        // the traversal evaluates it (a textured material builds a quadrature per refined
-        // point, and the scalar Rd's libm exponentials cost about six times as much).
-        let nodes = [0.5 - g, 0.5 + g];
-        let t: [f64; NODES] = core::array::from_fn(|j| ((j / 2) as f64 + nodes[j % 2]) * h);
-        let r2: [f32; NODES] = core::array::from_fn(|j| {
-            let r = t[j] * t[j] * f64::from(alpha);
-            (r * r) as f32
-        });
+        // Rd at every Gauss node, eight at a time as the traversal evaluates it (a textured
+        // material builds a quadrature per refined point, and the scalar Rd's libm
+        // exponentials cost about six times as much).
         let mut rd = [[0.0f32; NODES]; 3];
-        for (chunk, r2) in r2.chunks_exact(LANES).enumerate() {
+        for (chunk, r2) in layout.r2.chunks_exact(LANES).enumerate() {
             let values = profile.rd_lanes(DefaultLanes::load(r2));
             for (c, v) in values.iter().enumerate() {
                 rd[c][chunk * LANES..(chunk + 1) * LANES].copy_from_slice(&v.to_array());
@@ -285,11 +345,8 @@ impl RadialCdf {
         for m in 0..INTERVALS {
             let mut add = [0.0; 3];
             for j in [2 * m, 2 * m + 1] {
-                let rho = t[j] * t[j];
-                // dρ = 2t dt; each Gauss node weighs h/2.
-                let common = rho * Kernel::weight_unit(rho) * 2.0 * t[j] * h * 0.5;
                 for (c, a) in add.iter_mut().enumerate() {
-                    *a += common * f64::from(rd[c][j]);
+                    *a += layout.weight[j] * f64::from(rd[c][j]);
                 }
             }
             for c in 0..3 {
@@ -391,6 +448,30 @@ mod tests {
         assert_eq!(LocalQuadrature::new(&p, 0.1, 0, 0).len(), 1);
         assert_eq!(LocalQuadrature::new(&p, 0.1, 100, 100).len(), MAX_NODES);
         assert_eq!(LocalQuadrature::new(&p, f32::NAN, 4, 4).alpha(), 0.0);
+    }
+
+    /// One layout serves every profile: the same quadrature, bit for bit, as building it from
+    /// scratch, for every model and for albedos and mean free paths far apart.
+    #[test]
+    fn a_shared_layout_gives_the_quadrature_of_new() {
+        use crate::profile::{Distance, ProfileModel};
+        for (alpha, rings, per_ring) in [(0.05_f32, 3, 4), (0.7, 16, 4), (f32::NAN, 2, 2)] {
+            let layout = QuadratureLayout::new(alpha, rings, per_ring);
+            for model in ProfileModel::ALL {
+                for (kd, ell) in [(0.2, 0.01), (0.8, 0.05), (0.97, 2.0)] {
+                    let p = Profile::from_reflectance_with(
+                        model,
+                        Vec3::new(kd, kd * 0.5, 0.9),
+                        Distance::MeanFreePath(Vec3::new(ell, ell * 3.0, ell)),
+                        1.3,
+                    )
+                    .unwrap();
+                    let shared = LocalQuadrature::with_layout(&p, &layout);
+                    assert_eq!(shared, LocalQuadrature::new(&p, alpha, rings, per_ring));
+                    assert_eq!(shared.alpha(), layout.alpha());
+                }
+            }
+        }
     }
 
     /// The weights integrate a radial function g against w·Rd: Σ f·g(r) against the

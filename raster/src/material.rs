@@ -145,6 +145,8 @@ pub(crate) enum Params {
         base: Profile,
         kd: KdSource,
         distance: Distance,
+        /// [`log_span`] of the distance parameter.
+        log_span: f32,
     },
 }
 
@@ -187,20 +189,30 @@ impl KdSource {
     }
 }
 
-/// What a textured point's profile is built from at `uv`: the texture's K_d (clamped; `None`
-/// for a constant K_d), the model's albedo parameters and σ_t′ per channel.
-fn inputs_at(kd: &KdSource, distance: &Distance, uv: Vec2) -> (Option<Vec3>, [f64; 3], [f64; 3]) {
-    let kd_value = match kd {
+/// K_d at `uv` from a texture (clamped), `None` for a constant K_d.
+fn kd_at(kd: &KdSource, uv: Vec2) -> Option<Vec3> {
+    match kd {
         KdSource::Constant { .. } => None,
         KdSource::Texture { texture, .. } => Some(
             texture
                 .sample(uv)
                 .clamp(Vec3::splat(0.001), Vec3::splat(0.999)),
         ),
-    };
+    }
+}
+
+/// What a textured point's profile is built from at `uv`: the texture's K_d (clamped; `None`
+/// for a constant K_d), the model's albedo parameters and σ_t′ per channel.
+fn inputs_at(
+    kd: &KdSource,
+    distance: &Distance,
+    log_span: f32,
+    uv: Vec2,
+) -> (Option<Vec3>, [f64; 3], [f64; 3]) {
+    let kd_value = kd_at(kd, uv);
     let (albedo, dipole_albedo) = kd.albedos(kd_value.unwrap_or(Vec3::ZERO));
     let l = match distance {
-        Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, uv),
+        Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, log_span, uv),
     };
     (kd_value, albedo, extinction(distance, l, dipole_albedo))
 }
@@ -288,10 +300,12 @@ pub(crate) fn reflectance_params(
             }
         }
     };
+    let (Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p)) = distance;
     Ok(Params::Reflectance {
         base,
         kd,
         distance: distance.clone(),
+        log_span: log_span(p),
     })
 }
 
@@ -314,25 +328,37 @@ pub struct PointMaterial {
     pub kd: Option<Vec3>,
 }
 
-fn scalar_at(p: &ScalarParam, uv: Vec2) -> Vec3 {
+/// ln(max / min) of a texture-mapped distance (0 for a constant): the scale of the exponent
+/// in `min · (max / min)^t`, computed once per material rather than at every point.
+fn log_span(p: &ScalarParam) -> f32 {
     match p {
-        ScalarParam::Constant(v) => *v,
-        ScalarParam::Texture { texture, .. } => scalar_at_value(p, texture.sample(uv)),
+        ScalarParam::Constant(_) => 0.0,
+        ScalarParam::Texture { min, max, .. } => (max / min).ln(),
     }
 }
 
-/// A distance parameter at texture value `t` (clamped to [0, 1]).
-fn scalar_at_value(p: &ScalarParam, t: Vec3) -> Vec3 {
+/// A distance parameter at `uv`; `log_span` is [`log_span`]`(p)`.
+fn scalar_at(p: &ScalarParam, log_span: f32, uv: Vec2) -> Vec3 {
     match p {
         ScalarParam::Constant(v) => *v,
-        ScalarParam::Texture { min, max, .. } => {
+        ScalarParam::Texture { texture, .. } => scalar_at_value(p, log_span, texture.sample(uv)),
+    }
+}
+
+/// A distance parameter at texture value `t` (clamped to [0, 1]); `log_span` is
+/// [`log_span`]`(p)`.
+fn scalar_at_value(p: &ScalarParam, log_span: f32, t: Vec3) -> Vec3 {
+    match p {
+        ScalarParam::Constant(v) => *v,
+        ScalarParam::Texture { min, .. } => {
             let t = t.clamp(Vec3::ZERO, Vec3::ONE);
-            let ratio = (max / min).ln();
-            Vec3::new(
-                min * (ratio * t.x).exp(),
-                min * (ratio * t.y).exp(),
-                min * (ratio * t.z).exp(),
-            )
+            let at = |t: f32| min * (log_span * t).exp();
+            // A grey texture (the usual radius map): one exponential for the three channels.
+            if t.x == t.y && t.y == t.z {
+                Vec3::splat(at(t.x))
+            } else {
+                Vec3::new(at(t.x), at(t.y), at(t.z))
+            }
         }
     }
 }
@@ -353,7 +379,7 @@ fn smallest_scalar(p: &ScalarParam) -> Vec3 {
         ScalarParam::Texture { texture, .. } => {
             let (lo, hi) = texel_range(texture);
             // min·(max/min)^t is monotone in t: the extreme is at one end of the texel range.
-            let at = |t: Vec3| scalar_at_value(p, t);
+            let at = |t: Vec3| scalar_at_value(p, log_span(p), t);
             at(lo).min(at(hi))
         }
     }
@@ -399,7 +425,9 @@ impl TranslucentShader {
     pub fn smallest_diffuse_mean_free_path(&self) -> Vec3 {
         let (base, kd, distance) = match &self.params {
             Params::Fixed(p) => return p.diffuse_mean_free_path(),
-            Params::Reflectance { base, kd, distance } => (base, kd, distance),
+            Params::Reflectance {
+                base, kd, distance, ..
+            } => (base, kd, distance),
         };
         let smallest_distance = match distance {
             Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => smallest_scalar(p),
@@ -454,27 +482,45 @@ impl TranslucentShader {
     /// `total_reflectance()` and `mean_free_path()`, to the albedo inversion's accuracy): the
     /// second pass compares them between a pixel's sub-samples.
     pub fn parameters_at(&self, uv: Vec2) -> [Vec3; 2] {
-        let (base, kd, distance) = match &self.params {
+        let (base, kd, distance, log_span) = match &self.params {
             Params::Fixed(p) => return [p.total_reflectance(), p.mean_free_path()],
-            Params::Reflectance { base, kd, distance } => (base, kd, distance),
+            Params::Reflectance {
+                base,
+                kd,
+                distance,
+                log_span,
+            } => (base, kd, distance, *log_span),
         };
-        let (kd_value, _, sigma_t) = inputs_at(kd, distance, uv);
+        let kd_value = kd_at(kd, uv);
         let total = kd_value.unwrap_or_else(|| base.total_reflectance());
-        [total, Vec3::from_array(sigma_t.map(|s| (1.0 / s) as f32))]
+        let ell = match distance {
+            // ℓ_u is the parameter itself: no albedo inversion.
+            Distance::MeanFreePath(p) => scalar_at(p, log_span, uv),
+            Distance::DiffuseMeanFreePath(_) => {
+                let (_, _, sigma_t) = inputs_at(kd, distance, log_span, uv);
+                Vec3::from_array(sigma_t.map(|s| (1.0 / s) as f32))
+            }
+        };
+        [total, ell]
     }
 
     /// The material at texture coordinate `uv` (ignored when nothing is textured).
     pub fn at(&self, uv: Vec2) -> Result<PointMaterial, ParamError> {
-        let (base, kd, distance) = match &self.params {
+        let (base, kd, distance, log_span) = match &self.params {
             Params::Fixed(p) => {
                 return Ok(PointMaterial {
                     profile: *p,
                     kd: None,
                 });
             }
-            Params::Reflectance { base, kd, distance } => (base, kd, distance),
+            Params::Reflectance {
+                base,
+                kd,
+                distance,
+                log_span,
+            } => (base, kd, distance, *log_span),
         };
-        let (kd_value, albedo, sigma_t) = inputs_at(kd, distance, uv);
+        let (kd_value, albedo, sigma_t) = inputs_at(kd, distance, log_span, uv);
         let profile = match kd_value {
             Some(kd) => base.with_reflectance_albedo_and_extinction(kd, albedo, sigma_t)?,
             None => base.with_albedo_and_extinction(albedo, sigma_t)?,

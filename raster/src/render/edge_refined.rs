@@ -14,7 +14,7 @@
 //! ```
 
 use glam::Vec3;
-use lucent_core::{Exitance, LocalQuadrature, LocalTerm, Profile};
+use lucent_core::{Exitance, LocalQuadrature, LocalTerm, Profile, QuadratureLayout};
 
 use crate::lights::{Lighting, ShadowHints};
 use crate::sampling::rng::splitmix64;
@@ -23,6 +23,15 @@ use crate::sampling::rng::splitmix64;
 pub fn quadrature(profile: &Profile, alpha: f32) -> LocalQuadrature {
     LocalQuadrature::new(
         profile,
+        alpha,
+        LocalQuadrature::DEFAULT_RINGS,
+        LocalQuadrature::DEFAULT_PER_RING,
+    )
+}
+
+/// The layout of [`quadrature`] at α: what a texture-mapped material's refined points share.
+pub fn layout(alpha: f32) -> QuadratureLayout {
+    QuadratureLayout::new(
         alpha,
         LocalQuadrature::DEFAULT_RINGS,
         LocalQuadrature::DEFAULT_PER_RING,

@@ -14,7 +14,8 @@ use glam::{Mat4, Vec2, Vec3};
 use lucent_core::internals::fresnel;
 use lucent_core::stats::{NoStats, QueryStats, StatsSink};
 use lucent_core::{
-    IrradianceCache, LocalQuadrature, LocalTerm, QueryPlan, QuerySettings, ShadingPoint,
+    IrradianceCache, LocalQuadrature, LocalTerm, QuadratureLayout, QueryPlan, QuerySettings,
+    ShadingPoint,
 };
 
 use super::RenderError;
@@ -41,9 +42,11 @@ pub struct ObjectCache {
     /// ([`LocalIntegral::exact`]), so it carries no table interpolation error and costs no
     /// lookup at the shading points (a table lookup cost about 6% of a lookup on the sphere).
     pub uniform_k: Option<LocalTerm>,
-    /// The edge-refined quadrature when the material does not vary (textured materials build
-    /// theirs at each refined point).
+    /// The edge-refined quadrature when the material does not vary.
     pub quadrature: Option<LocalQuadrature>,
+    /// When the material varies: the edge-refined quadrature's layout, which each refined
+    /// point's own quadrature is built on.
+    pub quadrature_layout: Option<QuadratureLayout>,
     /// When the material does not vary over the surface: the material, and the query's checks
     /// and constants done once ([`IrradianceCache::plan`]) instead of at every shading point.
     pub uniform: Option<UniformMaterial>,
@@ -122,6 +125,9 @@ impl ObjectCache {
             local,
             uniform_k,
             quadrature,
+            quadrature_layout: shader
+                .filter(|s| s.is_textured())
+                .map(|_| edge_refined::layout(alpha)),
             uniform,
             textured_plan,
         })
@@ -433,9 +439,13 @@ impl Shading<'_> {
                 };
                 let m = m.map_err(|source| RenderError::Query { position, source })?;
                 let m = if m.refine {
-                    let q = oc
-                        .quadrature
-                        .unwrap_or_else(|| edge_refined::quadrature(&point.profile, oc.alpha));
+                    let q = match (&oc.quadrature, &oc.quadrature_layout) {
+                        (Some(q), _) => *q,
+                        (None, Some(layout)) => {
+                            LocalQuadrature::with_layout(&point.profile, layout)
+                        }
+                        (None, None) => edge_refined::quadrature(&point.profile, oc.alpha),
+                    };
                     let at = RefinePoint {
                         position,
                         normal,
