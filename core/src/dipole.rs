@@ -275,8 +275,8 @@ impl Dipole {
     /// exponentials. The six exponentials of the channels' Rd(0) take one 8-lane evaluation
     /// (the same bits as one at a time), and the checks are joined without a branch each; when
     /// one fails, the channels are built in order for the error the first bad one gives.
-    /// Written into `out` (a profile's own channels: no copy of the three), which is left as
-    /// it was on an error.
+    /// Written into `out` (a profile's own channels: no copy of the three), whose contents are
+    /// unspecified after an error.
     pub(crate) fn fill_from_known_terms(
         out: &mut [Self; 3],
         a: f64,
@@ -293,19 +293,18 @@ impl Dipole {
         });
         if inputs_valid {
             let factor = virtual_depth_factor(a);
-            let mut d: [Self; 3] = core::array::from_fn(|c| {
-                Self::without_rd_zero(albedo[c], sigma_t[c], factor, rd_total[c])
-            });
             let mut exponents = [0.0f32; LANES];
-            for (c, d) in d.iter().enumerate() {
+            for (c, d) in out.iter_mut().enumerate() {
+                *d = Self::without_rd_zero(albedo[c], sigma_t[c], factor, rd_total[c]);
                 exponents[2 * c..2 * c + 2].copy_from_slice(&d.rd_zero_exponents());
             }
             let e = math::exp_nonpositive_poly_8(exponents);
-            for (c, d) in d.iter_mut().enumerate() {
+            let mut valid = true;
+            for (c, d) in out.iter_mut().enumerate() {
                 d.set_rd_zero(e[2 * c], e[2 * c + 1]);
+                valid &= d.ranges_valid();
             }
-            if d.iter().fold(true, |ok, d| ok & d.ranges_valid()) {
-                *out = d;
+            if valid {
                 return Ok(());
             }
         }

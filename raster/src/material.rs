@@ -193,12 +193,13 @@ impl KdSource {
 fn kd_at(kd: &KdSource, uv: Vec2) -> Option<Vec3> {
     match kd {
         KdSource::Constant { .. } => None,
-        KdSource::Texture { texture, .. } => Some(
-            texture
-                .sample(uv)
-                .clamp(Vec3::splat(0.001), Vec3::splat(0.999)),
-        ),
+        KdSource::Texture { texture, .. } => Some(clamp_kd(texture.sample(uv))),
     }
+}
+
+/// A texture's K_d clamped into [0.001, 0.999], where every model's inversion is defined.
+fn clamp_kd(kd: Vec3) -> Vec3 {
+    kd.clamp(Vec3::splat(0.001), Vec3::splat(0.999))
 }
 
 /// What a textured point's profile is built from at `uv`: the texture's K_d (clamped; `None`
@@ -209,11 +210,16 @@ fn inputs_at(
     log_span: f32,
     uv: Vec2,
 ) -> (Option<Vec3>, [f64; 3], [f64; 3]) {
-    let kd_value = kd_at(kd, uv);
-    let (albedo, dipole_albedo) = kd.albedos(kd_value.unwrap_or(Vec3::ZERO));
-    let l = match distance {
-        Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => scalar_at(p, log_span, uv),
+    let (Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p)) = distance;
+    let (kd_value, l) = match (kd, p) {
+        // Both textured: one footprint where they have the same size.
+        (KdSource::Texture { texture: a, .. }, ScalarParam::Texture { texture: b, .. }) => {
+            let (kd, t) = Texture::sample_pair(a, b, uv);
+            (Some(clamp_kd(kd)), scalar_at_value(p, log_span, t))
+        }
+        _ => (kd_at(kd, uv), scalar_at(p, log_span, uv)),
     };
+    let (albedo, dipole_albedo) = kd.albedos(kd_value.unwrap_or(Vec3::ZERO));
     (kd_value, albedo, extinction(distance, l, dipole_albedo))
 }
 

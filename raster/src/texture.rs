@@ -114,17 +114,55 @@ impl Texture {
     /// returned exactly at `uv = ((i + ½)/width, 1 − (j + ½)/height)`. Non-finite coordinates
     /// are treated as 0. An empty (or inconsistent) texture samples as black.
     pub fn sample(&self, uv: Vec2) -> Vec3 {
-        let (w, h) = (self.width as usize, self.height as usize);
-        if w == 0 || h == 0 || self.texels.len() < w * h {
-            return Vec3::ZERO;
+        match self.footprint(uv) {
+            Some(at) => self.sample_at(&at),
+            None => Vec3::ZERO,
         }
+    }
+
+    /// [`Texture::sample`] of two textures at one `uv`: where they have the same size, the
+    /// texels and weights are found once (a material's K_d and radius maps usually share a
+    /// resolution).
+    pub fn sample_pair(a: &Texture, b: &Texture, uv: Vec2) -> (Vec3, Vec3) {
+        match a.footprint(uv) {
+            Some(at) if (a.width, a.height) == (b.width, b.height) && b.is_complete() => {
+                (a.sample_at(&at), b.sample_at(&at))
+            }
+            _ => (a.sample(uv), b.sample(uv)),
+        }
+    }
+
+    /// Where a bilinear lookup at `uv` reads; `None` for an empty (or inconsistent) texture.
+    fn footprint(&self, uv: Vec2) -> Option<Footprint> {
+        if !self.is_complete() {
+            return None;
+        }
+        let (w, h) = (self.width as usize, self.height as usize);
         let (x0, x1, fx) = wrap_axis(uv.x, w);
         // Rows are stored top first, v grows upwards: flip before wrapping.
         let (y0, y1, fy) = wrap_axis(1.0 - uv.y, h);
-        let t = |x: usize, y: usize| self.texels[y * w + x];
-        let top = t(x0, y0).lerp(t(x1, y0), fx);
-        let bottom = t(x0, y1).lerp(t(x1, y1), fx);
-        top.lerp(bottom, fy)
+        Some(Footprint {
+            row0: y0 * w,
+            row1: y1 * w,
+            x0,
+            x1,
+            fx,
+            fy,
+        })
+    }
+
+    /// Whether the texture is not empty and holds all its texels.
+    fn is_complete(&self) -> bool {
+        let (w, h) = (self.width as usize, self.height as usize);
+        w != 0 && h != 0 && self.texels.len() >= w * h
+    }
+
+    /// The bilinear blend at a footprint of this texture (or of one of the same size).
+    fn sample_at(&self, at: &Footprint) -> Vec3 {
+        let t = |row: usize, x: usize| self.texels[row + x];
+        let top = t(at.row0, at.x0).lerp(t(at.row0, at.x1), at.fx);
+        let bottom = t(at.row1, at.x0).lerp(t(at.row1, at.x1), at.fx);
+        top.lerp(bottom, at.fy)
     }
 
     /// Decodes a file held in memory, its format detected from its content
@@ -231,6 +269,18 @@ fn floor(x: f32) -> f32 {
     }
     let t = x as i32 as f32;
     if t > x { t - 1.0 } else { t }
+}
+
+/// The four texels a bilinear lookup reads (`row0`, `row1`: the offsets of its two rows;
+/// `x0`, `x1`: its two columns) and the weights of the second column and row.
+#[derive(Clone, Copy, Debug)]
+struct Footprint {
+    row0: usize,
+    row1: usize,
+    x0: usize,
+    x1: usize,
+    fx: f32,
+    fy: f32,
 }
 
 /// Repeat-wraps one texture coordinate: the two texel indices to blend and the weight of the

@@ -51,6 +51,40 @@ fn sample_hits_texel_centres_exactly() {
     assert_eq!(t.sample(Vec2::new(0.75, 0.25)), d);
 }
 
+/// Two textures sampled together give each one's own lookup, bit for bit: of the same size
+/// (one footprint), of different sizes, and with an empty one (black, as alone).
+#[test]
+fn sample_pair_is_two_samples() {
+    let ramp = |w: u32, h: u32, k: f32| {
+        let texels = (0..w * h)
+            .map(|i| Vec3::new(i as f32 * k, 1.0 / (i as f32 + 1.5), (i % 3) as f32))
+            .collect();
+        texture(w, h, texels)
+    };
+    let (a, b, c) = (ramp(3, 2, 0.1), ramp(3, 2, 0.7), ramp(5, 4, 0.3));
+    let empty = texture(0, 0, Vec::new());
+    let uvs = [
+        Vec2::new(0.1, 0.2),
+        Vec2::new(0.999, 0.0),
+        Vec2::new(-1.3, 7.25),
+        Vec2::new(f32::NAN, 0.5),
+        Vec2::new(1.0 / 3.0, 0.5),
+    ];
+    for uv in uvs {
+        for (x, y) in [(&a, &b), (&a, &c), (&c, &a), (&a, &empty), (&empty, &a)] {
+            let (p, q) = Texture::sample_pair(x, y, uv);
+            assert_eq!(
+                (p.to_array(), q.to_array()),
+                (x.sample(uv).to_array(), y.sample(uv).to_array())
+            );
+        }
+    }
+    assert_ne!(
+        Texture::sample_pair(&a, &b, uvs[0]).0,
+        Texture::sample_pair(&a, &b, uvs[0]).1
+    );
+}
+
 #[test]
 fn sample_is_bilinear_against_hand_computed_values() {
     // 3 × 2 scalar texture, values in the red channel:
