@@ -342,6 +342,7 @@ impl Profile {
     /// reflectance `kd` under this model (a texture's K_d at the shading point): the classical
     /// dipole takes `kd` as its Rd_total instead of evaluating Rd_total(α′) again (two double
     /// exponentials per channel; they agree to the inversion's accuracy, 1e-4).
+    #[inline]
     pub fn with_reflectance_albedo_and_extinction(
         &self,
         kd: Vec3,
@@ -351,6 +352,7 @@ impl Profile {
         self.rebuilt(albedo, sigma_t, Some(kd))
     }
 
+    #[inline]
     fn rebuilt(
         &self,
         albedo: [f64; 3],
@@ -395,6 +397,7 @@ impl Profile {
     /// The profile as a query on a cache of mean sample area `mean_area` evaluates it: for
     /// Burley, whose R diverges at r = 0, point values capped at the disc average over the
     /// mean sample's disc ([`Burley::with_near_cap`]); the dipoles are returned unchanged.
+    #[inline]
     pub fn for_sample_area(&self, mean_area: f32) -> Self {
         match &self.channels {
             Channels::Burley(ch, fit) => Profile {
@@ -460,6 +463,7 @@ impl Profile {
     }
     /// Rd(0) per channel: N10's weight for the shading point itself (for Burley, the cap of
     /// [`Profile::for_sample_area`]).
+    #[inline]
     pub fn rd_zero(&self) -> Vec3 {
         each_model!(self, c => Vec3::from(c.map(|d| d.rd_zero())))
     }
@@ -476,6 +480,7 @@ impl Profile {
         Vec3::from(self.albedo_parameters().map(|a| a as f32))
     }
     /// Mean free path ℓ_u = 1/σ_t′ per channel.
+    #[inline]
     pub fn mean_free_path(&self) -> Vec3 {
         each_model!(self, c => Vec3::from(c.map(|d| d.mean_free_path())))
     }

@@ -367,6 +367,7 @@ impl IrradianceCache {
     /// settings were checked and the cache's scales computed when `plan` was made, and the
     /// kernel is kept when α is the same. Checks `local` as [`IrradianceCache::plan`] does and
     /// gives the plan it would give, bit for bit.
+    #[inline]
     pub fn replan(
         &self,
         plan: &QueryPlan,

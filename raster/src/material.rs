@@ -204,6 +204,7 @@ fn clamp_kd(kd: Vec3) -> Vec3 {
 
 /// What a textured point's profile is built from at `uv`: the texture's K_d (clamped; `None`
 /// for a constant K_d), the model's albedo parameters and σ_t′ per channel.
+#[inline]
 fn inputs_at(
     kd: &KdSource,
     distance: &Distance,
@@ -511,6 +512,7 @@ impl TranslucentShader {
     }
 
     /// The material at texture coordinate `uv` (ignored when nothing is textured).
+    #[inline]
     pub fn at(&self, uv: Vec2) -> Result<PointMaterial, ParamError> {
         let (base, kd, distance, log_span) = match &self.params {
             Params::Fixed(p) => {
@@ -588,6 +590,7 @@ impl LocalIntegral {
     }
 
     /// The local term at a surface point.
+    #[inline]
     pub fn lookup(&self, point: &PointMaterial) -> LocalTerm {
         let ell = point.profile.mean_free_path();
         match self {
