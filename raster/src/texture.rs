@@ -124,12 +124,15 @@ impl Texture {
     /// texels and weights are found once (a material's K_d and radius maps usually share a
     /// resolution).
     pub fn sample_pair(a: &Texture, b: &Texture, uv: Vec2) -> (Vec3, Vec3) {
-        match a.footprint(uv) {
-            Some(at) if (a.width, a.height) == (b.width, b.height) && b.is_complete() => {
-                (a.sample_at(&at), b.sample_at(&at))
-            }
-            _ => (a.sample(uv), b.sample(uv)),
-        }
+        let Some(at) = a.footprint(uv) else {
+            return (Vec3::ZERO, b.sample(uv));
+        };
+        let second = if (a.width, a.height) == (b.width, b.height) && b.is_complete() {
+            b.sample_at(&at)
+        } else {
+            b.sample(uv)
+        };
+        (a.sample_at(&at), second)
     }
 
     /// Where a bilinear lookup at `uv` reads; `None` for an empty (or inconsistent) texture.
