@@ -286,6 +286,10 @@ pub struct LocalIntegralTable {
     /// `entries[k − k_lo][c]` = the two words of the [`Segment`] from ℓ = α·2^k to α·2^(k+1)
     /// for channel c, each `EMPTY` until computed.
     entries: Vec<[[AtomicU64; 2]; 3]>,
+    /// `nodes[k − k_lo][c]` = the f64 bits of channel c's K and d ln K / d log₂ ℓ at node k
+    /// (one more than the segments), each `EMPTY` until computed: two neighbouring segments
+    /// share a node, and it is computed once.
+    nodes: Vec<[[AtomicU64; 2]; 3]>,
     /// The quadrature rule of the nodes, built once (shared by a set of tables).
     rule: Arc<GaussLegendre<32>>,
 }
@@ -333,9 +337,9 @@ impl LocalIntegralTable {
         } else {
             (math::ilog2(ratio_min) + 1).min(K_MAX)
         };
-        let entries = (k_lo..=K_MAX)
-            .map(|_| [const { [const { AtomicU64::new(EMPTY) }; 2] }; 3])
-            .collect();
+        let empty = || [const { [const { AtomicU64::new(EMPTY) }; 2] }; 3];
+        let entries = (k_lo..=K_MAX).map(|_| empty()).collect();
+        let nodes = (k_lo..=K_MAX + 1).map(|_| empty()).collect();
         Ok(LocalIntegralTable {
             channels,
             alpha,
@@ -343,6 +347,7 @@ impl LocalIntegralTable {
             ratio_min,
             k_lo,
             entries,
+            nodes,
             rule,
         })
     }
@@ -410,28 +415,40 @@ impl LocalIntegralTable {
         }
     }
 
-    /// Computes and stores a segment (out of line: it runs once per segment). Its two nodes
-    /// are computed afresh, also where the neighbouring segment has one of them: the
-    /// quadrature is deterministic, so both get the same bits.
+    /// Computes and stores a segment (out of line: it runs once per segment) from its two
+    /// nodes, each computed once ([`LocalIntegralTable::node`]).
     #[cold]
     #[inline(never)]
     fn fill(&self, slots: &[AtomicU64; 2], c: usize, k: i32) -> Segment {
-        let unit = &self.channels[c].unit;
-        let node = |k: i32| {
-            let (v, a_dk_da) = unit.local_integral_and_slope_with(math::pow2i64(-k), &self.rule);
-            // d ln K / d log₂ ℓ = −ln 2 · a·(dK/da) / K.
-            let slope = if v > 0.0 {
-                -core::f64::consts::LN_2 * a_dk_da / v
-            } else {
-                0.0
-            };
-            (v, slope)
-        };
-        let segment = Segment::new(node(k), node(k + 1));
+        let segment = Segment::new(self.node(c, k), self.node(c, k + 1));
         let bits = segment.to_bits();
         slots[0].store(bits[0], Ordering::Relaxed);
         slots[1].store(bits[1], Ordering::Relaxed);
         segment
+    }
+
+    /// Channel c's (K, d ln K / d log₂ ℓ) at node k (ℓ = α·2^k), by quadrature on first use.
+    /// The quadrature is deterministic, so threads that race compute and store the same bits.
+    fn node(&self, c: usize, k: i32) -> (f64, f64) {
+        let slots = &self.nodes[(k - self.k_lo) as usize][c];
+        let bits = [
+            slots[0].load(Ordering::Relaxed),
+            slots[1].load(Ordering::Relaxed),
+        ];
+        if bits[0] != EMPTY && bits[1] != EMPTY {
+            return (f64::from_bits(bits[0]), f64::from_bits(bits[1]));
+        }
+        let unit = &self.channels[c].unit;
+        let (v, a_dk_da) = unit.local_integral_and_slope_with(math::pow2i64(-k), &self.rule);
+        // d ln K / d log₂ ℓ = −ln 2 · a·(dK/da) / K.
+        let slope = if v > 0.0 {
+            -core::f64::consts::LN_2 * a_dk_da / v
+        } else {
+            0.0
+        };
+        slots[0].store(v.to_bits(), Ordering::Relaxed);
+        slots[1].store(slope.to_bits(), Ordering::Relaxed);
+        (v, slope)
     }
 
     /// K(ℓ_u) per channel by power-of-two interpolation (monotone cubic Hermite in log K over
@@ -577,6 +594,39 @@ mod tests {
 
     /// An independent quadrature: composite Simpson in u = ρ² (K = π ∫₀^(a²) w Rd_1(√u) du)
     /// on a graded grid.
+    /// Segments whose nodes were computed for a neighbour (filled upwards, downwards, and
+    /// every other one first) are the segments of a table that computes only that one.
+    #[test]
+    fn shared_nodes_give_each_segment_its_own_bits() {
+        let p = profile(0.6, 1.3);
+        let alpha = 0.1;
+        let table = || LocalIntegralTable::new(&p, alpha, alpha / 1024.0).unwrap();
+        let k_lo = table().k_lo;
+        let ks: Vec<i32> = (k_lo..k_lo + 12).collect();
+        let orders: [Vec<i32>; 3] = [
+            ks.clone(),
+            ks.iter().rev().copied().collect(),
+            ks.iter()
+                .step_by(2)
+                .chain(ks.iter().skip(1).step_by(2))
+                .copied()
+                .collect(),
+        ];
+        for order in orders {
+            let shared = table();
+            for &k in &order {
+                for c in 0..3 {
+                    let alone = table().segment(c, k);
+                    assert_eq!(
+                        shared.segment(c, k).to_bits(),
+                        alone.to_bits(),
+                        "k {k}, c {c}"
+                    );
+                }
+            }
+        }
+    }
+
     fn simpson_reference(d: &UnitDipole, a: f64) -> f64 {
         let n = 200_000;
         let umax = a * a;

@@ -558,9 +558,9 @@ impl TranslucentShader {
                 ell_min,
             )?))
         } else {
-            Ok(LocalIntegral::Single(LocalIntegralTable::new(
+            Ok(LocalIntegral::Single(Box::new(LocalIntegralTable::new(
                 base, alpha, ell_min,
-            )?))
+            )?)))
         }
     }
 }
@@ -569,7 +569,7 @@ impl TranslucentShader {
 #[derive(Debug)]
 pub enum LocalIntegral {
     /// Constant K_d: one table over ℓ.
-    Single(LocalIntegralTable),
+    Single(Box<LocalIntegralTable>),
     /// Texture-mapped K_d: tables at evenly spaced K_d.
     ByKd(LocalIntegralByKd),
 }
