@@ -415,6 +415,20 @@ impl TranslucentShader {
         }
     }
 
+    /// The base profile, K_d source, distance and [`log_span`] of a material given by K_d and a
+    /// distance; `None` for fixed coefficients.
+    fn reflectance(&self) -> Option<(&Profile, &KdSource, &Distance, f32)> {
+        match &self.params {
+            Params::Fixed(_) => None,
+            Params::Reflectance {
+                base,
+                kd,
+                distance,
+                log_span,
+            } => Some((base, kd, distance, *log_span)),
+        }
+    }
+
     /// The smallest decay length of the profile anywhere on the surface, per channel
     /// ([`Profile::diffuse_mean_free_path`]: ℓ_d = 1/σ_tr for the dipoles, 3d for Burley): what
     /// the irradiance sample spacing must resolve.
@@ -489,14 +503,9 @@ impl TranslucentShader {
     /// `total_reflectance()` and `mean_free_path()`, to the albedo inversion's accuracy): the
     /// second pass compares them between a pixel's sub-samples.
     pub fn parameters_at(&self, uv: Vec2) -> [Vec3; 2] {
-        let (base, kd, distance, log_span) = match &self.params {
-            Params::Fixed(p) => return [p.total_reflectance(), p.mean_free_path()],
-            Params::Reflectance {
-                base,
-                kd,
-                distance,
-                log_span,
-            } => (base, kd, distance, *log_span),
+        let Some((base, kd, distance, log_span)) = self.reflectance() else {
+            let p = self.base_profile();
+            return [p.total_reflectance(), p.mean_free_path()];
         };
         let kd_value = kd_at(kd, uv);
         let total = kd_value.unwrap_or_else(|| base.total_reflectance());
@@ -514,19 +523,11 @@ impl TranslucentShader {
     /// The material at texture coordinate `uv` (ignored when nothing is textured).
     #[inline]
     pub fn at(&self, uv: Vec2) -> Result<PointMaterial, ParamError> {
-        let (base, kd, distance, log_span) = match &self.params {
-            Params::Fixed(p) => {
-                return Ok(PointMaterial {
-                    profile: *p,
-                    kd: None,
-                });
-            }
-            Params::Reflectance {
-                base,
-                kd,
-                distance,
-                log_span,
-            } => (base, kd, distance, *log_span),
+        let Some((base, kd, distance, log_span)) = self.reflectance() else {
+            return Ok(PointMaterial {
+                profile: *self.base_profile(),
+                kd: None,
+            });
         };
         let (kd_value, albedo, sigma_t) = inputs_at(kd, distance, log_span, uv);
         let profile = match kd_value {
