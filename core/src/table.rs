@@ -283,13 +283,17 @@ pub struct LocalIntegralTable {
     ratio_min: f32,
     /// Exponent of the first cached node: the smallest k with 2^k > ℓ_min / α.
     k_lo: i32,
-    /// `entries[k − k_lo][c]` = the two words of the [`Segment`] from ℓ = α·2^k to α·2^(k+1)
-    /// for channel c, each `EMPTY` until computed.
-    entries: Vec<[[AtomicU64; 2]; 3]>,
-    /// `nodes[k − k_lo][c]` = the f64 bits of channel c's K and d ln K / d log₂ ℓ at node k
-    /// (one more than the segments), each `EMPTY` until computed: two neighbouring segments
-    /// share a node, and it is computed once.
-    nodes: Vec<[[AtomicU64; 2]; 3]>,
+    /// Channels with storage of their own: 1 when the profile is grey (its three channels have
+    /// one unit shape, so one set of segments and nodes serves all three, with the same bits),
+    /// else 3.
+    stored: usize,
+    /// `entries[(k − k_lo)·stored + slot(c)]` = the two words of the [`Segment`] from
+    /// ℓ = α·2^k to α·2^(k+1) for channel c, each `EMPTY` until computed.
+    entries: Vec<[AtomicU64; 2]>,
+    /// `nodes[(k − k_lo)·stored + slot(c)]` = the f64 bits of channel c's K and
+    /// d ln K / d log₂ ℓ at node k (one more row than the segments), each `EMPTY` until
+    /// computed: two neighbouring segments share a node, and it is computed once.
+    nodes: Vec<[AtomicU64; 2]>,
     /// The quadrature rule of the nodes, built once (shared by a set of tables).
     rule: Arc<GaussLegendre<32>>,
 }
@@ -337,17 +341,26 @@ impl LocalIntegralTable {
         } else {
             (math::ilog2(ratio_min) + 1).min(K_MAX)
         };
-        let empty = || [const { [const { AtomicU64::new(EMPTY) }; 2] }; 3];
-        let entries = (k_lo..=K_MAX).map(|_| empty()).collect();
-        let nodes = (k_lo..=K_MAX + 1).map(|_| empty()).collect();
+        let albedo = profile.albedo_parameters();
+        let stored = if albedo[0] == albedo[1] && albedo[1] == albedo[2] {
+            1
+        } else {
+            3
+        };
+        let empty = |rows: i32| {
+            (0..rows as usize * stored)
+                .map(|_| [const { AtomicU64::new(EMPTY) }; 2])
+                .collect()
+        };
         Ok(LocalIntegralTable {
             channels,
             alpha,
             ell_min,
             ratio_min,
             k_lo,
-            entries,
-            nodes,
+            stored,
+            entries: empty(K_MAX - k_lo + 1),
+            nodes: empty(K_MAX - k_lo + 2),
             rule,
         })
     }
@@ -401,7 +414,7 @@ impl LocalIntegralTable {
     /// invariant.
     #[inline(always)]
     fn segment(&self, c: usize, k: i32) -> Segment {
-        let slots = &self.entries[(k - self.k_lo) as usize][c];
+        let slots = &self.entries[self.index(c, k)];
         let bits = [
             slots[0].load(Ordering::Relaxed),
             slots[1].load(Ordering::Relaxed),
@@ -413,6 +426,12 @@ impl LocalIntegralTable {
         } else {
             self.fill(slots, c, k)
         }
+    }
+
+    /// Where channel c's segment (or node) k is stored in `entries` (or `nodes`).
+    #[inline(always)]
+    fn index(&self, c: usize, k: i32) -> usize {
+        (k - self.k_lo) as usize * self.stored + c.min(self.stored - 1)
     }
 
     /// Computes and stores a segment (out of line: it runs once per segment) from its two
@@ -430,7 +449,7 @@ impl LocalIntegralTable {
     /// Channel c's (K, d ln K / d log₂ ℓ) at node k (ℓ = α·2^k), by quadrature on first use.
     /// The quadrature is deterministic, so threads that race compute and store the same bits.
     fn node(&self, c: usize, k: i32) -> (f64, f64) {
-        let slots = &self.nodes[(k - self.k_lo) as usize][c];
+        let slots = &self.nodes[self.index(c, k)];
         let bits = [
             slots[0].load(Ordering::Relaxed),
             slots[1].load(Ordering::Relaxed),
@@ -569,12 +588,14 @@ impl LocalIntegralTable {
     /// The exponents k of the nodes (ℓ = α·2^k) computed so far (in any channel; segment k
     /// computes nodes k and k + 1), ascending.
     pub fn cached_exponents(&self) -> impl Iterator<Item = i32> + '_ {
-        let filled = |i: usize| {
-            self.entries
-                .get(i)
-                .is_some_and(|e| e.iter().any(|w| w[0].load(Ordering::Relaxed) != EMPTY))
+        let rows = self.entries.len() / self.stored;
+        let filled = move |i: usize| {
+            (i < rows)
+                && self.entries[i * self.stored..(i + 1) * self.stored]
+                    .iter()
+                    .any(|w| w[0].load(Ordering::Relaxed) != EMPTY)
         };
-        (0..=self.entries.len())
+        (0..=rows)
             .filter(move |&i| filled(i) || (i > 0 && filled(i - 1)))
             .map(move |i| self.k_lo + i as i32)
     }
@@ -594,6 +615,36 @@ mod tests {
 
     /// An independent quadrature: composite Simpson in u = ρ² (K = π ∫₀^(a²) w Rd_1(√u) du)
     /// on a graded grid.
+    /// A grey profile's table stores one channel and serves all three with the bits a table
+    /// of three stored channels gives the channel of the same albedo.
+    #[test]
+    fn a_grey_table_stores_one_channel() {
+        let alpha = 0.1;
+        let grey = LocalIntegralTable::new(&profile(0.6, 1.3), alpha, alpha / 1024.0).unwrap();
+        let coloured = Profile::from_reflectance(
+            Vec3::new(0.6, 0.3, 0.9),
+            Distance::MeanFreePath(Vec3::ONE),
+            1.3,
+        )
+        .unwrap();
+        let coloured = LocalIntegralTable::new(&coloured, alpha, alpha / 1024.0).unwrap();
+        assert_eq!((grey.stored, coloured.stored), (1, 3));
+        assert_eq!(grey.entries.len() * 3, coloured.entries.len());
+        for ell in [0.002, 0.03, 0.4, 5.0] {
+            let (g, c) = (
+                grey.lookup(Vec3::splat(ell)),
+                coloured.lookup(Vec3::splat(ell)),
+            );
+            assert_eq!(g.x.to_bits(), c.x.to_bits(), "ℓ {ell}");
+            assert_eq!(
+                (g.y.to_bits(), g.z.to_bits()),
+                (g.x.to_bits(), g.x.to_bits())
+            );
+            assert_ne!(c.y, c.x);
+        }
+        assert!(grey.cached_exponents().count() >= 4);
+    }
+
     /// Segments whose nodes were computed for a neighbour (filled upwards, downwards, and
     /// every other one first) are the segments of a table that computes only that one.
     #[test]
