@@ -57,9 +57,19 @@
 //! takes one logarithm (of ℓ/α, shared by the channels when they have the same ℓ), one
 //! segment load, a cubic and one polynomial exponential per channel.
 //!
-//! Concurrency: a segment is two `AtomicU64` words (layout at `Segment`) with a NaN pattern
-//! meaning "not yet computed". A lookup that finds an empty word computes the segment and
-//! stores both words with relaxed stores; two threads racing compute the same bits (the
+//! Storage: one row per exponent k from k_lo to 127, a slot per stored channel in each row —
+//! three, or one when the profile is grey (its channels share one unit shape, so one slot
+//! serves all three with the same bits). Each node's quadrature is cached too, so that two
+//! neighbouring segments compute the node they share once:
+//!
+//! ```text
+//!   entries: [ k_lo: r g b ][ k_lo + 1: r g b ] … [ 127: r g b ]       segments (r only if grey)
+//!   nodes:   [ k_lo: r g b ][ k_lo + 1: r g b ] … [ 127: r g b ][ 128 ] K and slope, f64 bits
+//! ```
+//!
+//! Concurrency: a segment (or a node) is two `AtomicU64` words (layout at `Segment`) with a NaN
+//! pattern meaning "not yet computed". A lookup that finds an empty word computes the segment
+//! and stores both words with relaxed stores; two threads racing compute the same bits (the
 //! quadrature is deterministic), so each word read is either empty or final, and no lock is
 //! needed on any path. [`LocalIntegralTable::prefill`] fills a declared range up front.
 
