@@ -170,9 +170,20 @@ pub struct Dipole {
     rd_total: f32,
 }
 
+/// Whether `albedo` is in (0, 1] (false for NaN). Without a branch: a texture-mapped material
+/// checks three channels per shading point.
+fn is_albedo(albedo: f64) -> bool {
+    (albedo > 0.0) & (albedo <= 1.0)
+}
+
+/// Whether `v` is finite and positive (false for NaN), without a branch.
+fn is_positive_length(v: f64) -> bool {
+    (v > 0.0) & (v <= f64::MAX)
+}
+
 /// An albedo parameter in (0, 1] (α′, or Burley's A).
 pub(crate) fn check_albedo(albedo: f64) -> Result<(), ParamError> {
-    if albedo > 0.0 && albedo <= 1.0 {
+    if is_albedo(albedo) {
         Ok(())
     } else {
         Err(ParamError::OutOfRange {
@@ -184,7 +195,7 @@ pub(crate) fn check_albedo(albedo: f64) -> Result<(), ParamError> {
 
 /// A finite, positive double-precision length or inverse length named `name`.
 pub(crate) fn check_positive_length(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v.is_finite() && v > 0.0 {
+    if is_positive_length(v) {
         Ok(())
     } else {
         Err(ParamError::NotPositive {
@@ -284,12 +295,8 @@ impl Dipole {
         albedo: [f64; 3],
         sigma_t: [f64; 3],
     ) -> Result<(), ParamError> {
-        // check_albedo and check_positive_length, NaN failing both.
         let inputs_valid = (0..3).fold(true, |ok, c| {
-            ok & (albedo[c] > 0.0)
-                & (albedo[c] <= 1.0)
-                & (sigma_t[c] > 0.0)
-                & (sigma_t[c] <= f64::MAX)
+            ok & is_albedo(albedo[c]) & is_positive_length(sigma_t[c])
         });
         if inputs_valid {
             let factor = virtual_depth_factor(a);

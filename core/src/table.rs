@@ -297,10 +297,10 @@ pub struct LocalIntegralTable {
     /// one unit shape, so one set of segments and nodes serves all three, with the same bits),
     /// else 3.
     stored: usize,
-    /// `entries[(k − k_lo)·stored + slot(c)]` = the two words of the [`Segment`] from
-    /// ℓ = α·2^k to α·2^(k+1) for channel c, each `EMPTY` until computed.
+    /// `entries[index(c, k)]` = the two words of the [`Segment`] from ℓ = α·2^k to
+    /// α·2^(k+1) for channel c, each `EMPTY` until computed ([`LocalIntegralTable::index`]).
     entries: Vec<[AtomicU64; 2]>,
-    /// `nodes[(k − k_lo)·stored + slot(c)]` = the f64 bits of channel c's K and
+    /// `nodes[index(c, k)]` = the f64 bits of channel c's K and
     /// d ln K / d log₂ ℓ at node k (one more row than the segments), each `EMPTY` until
     /// computed: two neighbouring segments share a node, and it is computed once.
     nodes: Vec<[AtomicU64; 2]>,
@@ -623,8 +623,6 @@ mod tests {
         Profile::from_reflectance(Vec3::splat(kd), Distance::MeanFreePath(Vec3::ONE), eta).unwrap()
     }
 
-    /// An independent quadrature: composite Simpson in u = ρ² (K = π ∫₀^(a²) w Rd_1(√u) du)
-    /// on a graded grid.
     /// A grey profile's table stores one channel and serves all three with the bits a table
     /// of three stored channels gives the channel of the same albedo.
     #[test]
@@ -688,6 +686,8 @@ mod tests {
         }
     }
 
+    /// An independent quadrature: composite Simpson in u = ρ² (K = π ∫₀^(a²) w Rd_1(√u) du)
+    /// on a graded grid.
     fn simpson_reference(d: &UnitDipole, a: f64) -> f64 {
         let n = 200_000;
         let umax = a * a;

@@ -211,7 +211,7 @@ fn inputs_at(
     log_span: f32,
     uv: Vec2,
 ) -> (Option<Vec3>, [f64; 3], [f64; 3]) {
-    let (Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p)) = distance;
+    let p = distance.param();
     let (kd_value, l) = match (kd, p) {
         // Both textured: one footprint where they have the same size.
         (KdSource::Texture { texture: a, .. }, ScalarParam::Texture { texture: b, .. }) => {
@@ -307,12 +307,11 @@ pub(crate) fn reflectance_params(
             }
         }
     };
-    let (Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p)) = distance;
     Ok(Params::Reflectance {
         base,
         kd,
         distance: distance.clone(),
-        log_span: log_span(p),
+        log_span: log_span(distance.param()),
     })
 }
 
@@ -399,11 +398,7 @@ impl TranslucentShader {
             Params::Fixed(_) => false,
             Params::Reflectance { kd, distance, .. } => {
                 matches!(kd, KdSource::Texture { .. })
-                    || matches!(
-                        distance,
-                        Distance::MeanFreePath(ScalarParam::Texture { .. })
-                            | Distance::DiffuseMeanFreePath(ScalarParam::Texture { .. })
-                    )
+                    || matches!(distance.param(), ScalarParam::Texture { .. })
             }
         }
     }
@@ -450,9 +445,7 @@ impl TranslucentShader {
                 base, kd, distance, ..
             } => (base, kd, distance),
         };
-        let smallest_distance = match distance {
-            Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => smallest_scalar(p),
-        };
+        let smallest_distance = smallest_scalar(distance.param());
         if base.model() != ProfileModel::Dipole {
             if !self.is_textured() {
                 return base.diffuse_mean_free_path();

@@ -21,12 +21,7 @@ use crate::sampling::rng::splitmix64;
 
 /// The quadrature of the edge-refined method for `profile` and α (the default node count).
 pub fn quadrature(profile: &Profile, alpha: f32) -> LocalQuadrature {
-    LocalQuadrature::new(
-        profile,
-        alpha,
-        LocalQuadrature::DEFAULT_RINGS,
-        LocalQuadrature::DEFAULT_PER_RING,
-    )
+    LocalQuadrature::with_layout(profile, &layout(alpha))
 }
 
 /// The layout of [`quadrature`] at α: what a texture-mapped material's refined points share.

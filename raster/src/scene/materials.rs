@@ -379,11 +379,7 @@ fn build_medium(
     }
     let textured = [
         (kd_from_mtl || matches!(kd, ColorParam::Texture(_))).then_some("kd"),
-        match &distance {
-            Distance::MeanFreePath(ScalarParam::Texture { .. })
-            | Distance::DiffuseMeanFreePath(ScalarParam::Texture { .. }) => Some(given_distance.0),
-            _ => None,
-        },
+        matches!(distance.param(), ScalarParam::Texture { .. }).then_some(given_distance.0),
     ];
     Ok((
         Medium::Reflectance { kd, distance, eta },

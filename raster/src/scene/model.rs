@@ -135,6 +135,15 @@ pub enum Distance {
     DiffuseMeanFreePath(ScalarParam),
 }
 
+impl Distance {
+    /// The value, whichever mean free path it is.
+    pub fn param(&self) -> &ScalarParam {
+        match self {
+            Distance::MeanFreePath(p) | Distance::DiffuseMeanFreePath(p) => p,
+        }
+    }
+}
+
 /// An RGB parameter: a constant or a texture over the mesh UVs.
 #[derive(Clone, Debug)]
 pub enum ColorParam {
