@@ -81,6 +81,7 @@ mod cell_average;
 mod dipole;
 pub mod error;
 mod fresnel;
+mod kd_grid;
 mod kd_tables;
 mod kernel;
 mod lanes;

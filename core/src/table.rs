@@ -383,6 +383,11 @@ impl LocalIntegralTable {
     pub fn ell_min(&self) -> f32 {
         self.ell_min
     }
+    /// ℓ/α of the first node: the smallest power of two above ℓ_min/α. Below it lookups ramp
+    /// to the limit.
+    pub(crate) fn first_node(&self) -> f32 {
+        math::pow2i(self.k_lo)
+    }
     /// The ℓ → 0 limit per channel: Rd_total(α′).
     pub fn limit(&self) -> Vec3 {
         Vec3::from(self.channels.map(|c| c.limit))

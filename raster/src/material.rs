@@ -378,15 +378,50 @@ fn texel_range(t: &Texture) -> (Vec3, Vec3) {
         })
 }
 
-/// The smallest value of a distance parameter over the surface, per channel.
-fn smallest_scalar(p: &ScalarParam) -> Vec3 {
+/// The smallest and largest value of a distance parameter over the surface, per channel.
+fn scalar_range(p: &ScalarParam) -> (Vec3, Vec3) {
     match p {
-        ScalarParam::Constant(v) => *v,
+        ScalarParam::Constant(v) => (*v, *v),
         ScalarParam::Texture { texture, .. } => {
             let (lo, hi) = texel_range(texture);
-            // min·(max/min)^t is monotone in t: the extreme is at one end of the texel range.
+            // min·(max/min)^t is monotone in t: the extremes are the ends of the texel range.
             let at = |t: Vec3| scalar_at_value(p, log_span(p), t);
-            at(lo).min(at(hi))
+            (at(lo).min(at(hi)), at(lo).max(at(hi)))
+        }
+    }
+}
+
+/// The smallest value of a distance parameter over the surface, per channel.
+fn smallest_scalar(p: &ScalarParam) -> Vec3 {
+    scalar_range(p).0
+}
+
+/// The range of a K_d texture over all channels, clamped as [`clamp_kd`] clamps its samples
+/// (bilinear samples lie between the texels).
+fn kd_range(texture: &Texture) -> (f32, f32) {
+    let (lo, hi) = texel_range(texture);
+    let clamp = |v: f32| v.clamp(0.001, 0.999);
+    (clamp(lo.min_element()), clamp(hi.max_element()))
+}
+
+/// The range of ℓ_u over the surface, all channels, for K_d ∈ `kd`: the distance parameter's
+/// range, converted from ℓ_d at each corner where the distance is ℓ_d (ℓ_u = ℓ_d·√(3(1 − α′))
+/// is monotone in ℓ_d and in K_d, so its extremes are corners).
+fn mean_free_path_range(kd: (f32, f32), source: &KdSource, distance: &Distance) -> (f32, f32) {
+    let (lo, hi) = scalar_range(distance.param());
+    let ends = [lo.min_element(), hi.max_element()];
+    match distance {
+        Distance::MeanFreePath(_) => (ends[0], ends[1]),
+        Distance::DiffuseMeanFreePath(_) => {
+            let mut range = (f32::INFINITY, f32::NEG_INFINITY);
+            for k in [kd.0, kd.1] {
+                let (_, dipole_albedo) = source.albedos(Vec3::splat(k));
+                for l in ends {
+                    let ell = (1.0 / extinction(distance, Vec3::splat(l), dipole_albedo)[0]) as f32;
+                    range = (range.0.min(ell), range.1.max(ell));
+                }
+            }
+            range
         }
     }
 }
@@ -536,21 +571,14 @@ impl TranslucentShader {
     /// The local-integral source for smoothing radius `alpha` and threshold `ell_min`: for a
     /// texture-mapped K_d, the tables over K_d of the material's model.
     pub fn local_term(&self, alpha: f32, ell_min: f32) -> Result<LocalIntegral, ParamError> {
-        let textured_kd = matches!(
-            &self.params,
-            Params::Reflectance {
-                kd: KdSource::Texture { .. },
-                ..
-            }
-        );
         let base = self.base_profile();
-        if textured_kd {
-            Ok(LocalIntegral::ByKd(LocalIntegralByKd::for_model(
-                base.model(),
-                base.eta(),
-                alpha,
-                ell_min,
-            )?))
+        if let Some((_, source @ KdSource::Texture { texture, .. }, distance, _)) =
+            self.reflectance()
+        {
+            let tables = LocalIntegralByKd::for_model(base.model(), base.eta(), alpha, ell_min)?;
+            let kd = kd_range(texture);
+            let ell = mean_free_path_range(kd, source, distance);
+            Ok(LocalIntegral::ByKd(tables.with_range(kd, ell)))
         } else {
             Ok(LocalIntegral::Single(Box::new(LocalIntegralTable::new(
                 base, alpha, ell_min,

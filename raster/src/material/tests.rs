@@ -105,11 +105,19 @@ fn textured_reflectance_takes_k_from_the_tables_over_kd() {
         .local_term(alpha, alpha / 1024.0)
         .unwrap()
         .lookup(&point);
-    let want = LocalIntegralByKd::new(1.4, alpha, alpha / 1024.0)
-        .unwrap()
-        .local_term(kd, point.profile.mean_free_path());
+    // The tables over K_d with the dense grid over the texture's range (K_d from its smallest
+    // to its largest channel, the one ℓ_u): the same bits.
+    let tables = LocalIntegralByKd::new(1.4, alpha, alpha / 1024.0).unwrap();
+    let ell = point.profile.mean_free_path();
+    let plain = tables.local_term(kd, ell);
+    let want = tables
+        .with_range((0.3, 0.9), (0.05, 0.05))
+        .local_term(kd, ell);
     assert_eq!(term, want);
     assert_eq!(term.alpha(), alpha);
+    // The grid adds little to the tables' own interpolation.
+    let rel = ((term.k() - plain.k()) / plain.k()).abs().max_element();
+    assert!(rel < 5e-4, "{} vs {}", term.k(), plain.k());
 }
 
 #[test]
@@ -250,6 +258,7 @@ fn textured_reflectance_follows_the_model() {
             .lookup(&point);
         let want = LocalIntegralByKd::for_model(model, 1.4, alpha, alpha / 1024.0)
             .unwrap()
+            .with_range((0.3, 0.9), (0.05, 0.05))
             .local_term(kd, point.profile.mean_free_path());
         assert_eq!(term, want, "{}", model.name());
     }
