@@ -352,6 +352,23 @@ impl Profile {
         self.rebuilt(albedo, sigma_t, Some(kd))
     }
 
+    /// [`Profile::with_albedo_and_extinction`] (`kd` `None`) or
+    /// [`Profile::with_reflectance_albedo_and_extinction`] written into `out`, the same bits:
+    /// for a caller that keeps one profile per thread and re-makes it at every shading point
+    /// instead of moving a new one. On an error `out` is a copy of this profile.
+    #[inline]
+    pub fn rebuild_into(
+        &self,
+        out: &mut Profile,
+        kd: Option<Vec3>,
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+    ) -> Result<(), ParamError> {
+        *out = *self;
+        out.refill(albedo, sigma_t, kd)
+            .inspect_err(|_| *out = *self)
+    }
+
     #[inline]
     fn rebuilt(
         &self,
@@ -361,10 +378,24 @@ impl Profile {
     ) -> Result<Self, ParamError> {
         // Built in a copy of this profile, its channels overwritten in place.
         let mut out = *self;
-        match &mut out.channels {
+        out.refill(albedo, sigma_t, kd)?;
+        Ok(out)
+    }
+
+    /// Overwrites the channels with the same model's for new albedo parameters and σ_t′ (η and
+    /// the model's η-only terms kept); `kd` is the known Rd_total where there is one.
+    #[inline]
+    fn refill(
+        &mut self,
+        albedo: [f64; 3],
+        sigma_t: [f64; 3],
+        kd: Option<Vec3>,
+    ) -> Result<(), ParamError> {
+        let eta = self.eta;
+        match &mut self.channels {
             Channels::Dipole(ch) => {
                 // η was validated when this profile was built: A(η) once for three channels.
-                let a = dipole::boundary_term(self.eta as f64);
+                let a = dipole::boundary_term(eta as f64);
                 let rd_total = core::array::from_fn(|c| {
                     // A constant K_d (only ℓ textured) keeps α′: reuse its Rd_total.
                     if albedo[c] == ch[c].albedo() {
@@ -372,7 +403,7 @@ impl Profile {
                     } else if let Some(kd) = kd {
                         kd[c] as f64
                     } else {
-                        dipole::total_reflectance(albedo[c], self.eta as f64)
+                        dipole::total_reflectance(albedo[c], eta as f64)
                     }
                 });
                 Dipole::fill_from_known_terms(ch, a, rd_total, albedo, sigma_t)?;
@@ -391,7 +422,7 @@ impl Profile {
                 })?;
             }
         }
-        Ok(out)
+        Ok(())
     }
 
     /// The profile as a query on a cache of mean sample area `mean_area` evaluates it: for
@@ -716,5 +747,57 @@ mod tests {
         let rhs = p.rd((r / 0.25) * (r / 0.25)) / (0.25 * 0.25);
         assert!(((lhs - rhs) / rhs).abs().max_element() < 1e-5);
         assert!(p.with_mean_free_path(Vec3::new(1.0, 0.0, 1.0)).is_err());
+    }
+
+    /// Re-made in place, into a profile that held another model's channels, a profile is the
+    /// one `with_albedo_and_extinction` and `with_reflectance_albedo_and_extinction` give, bit
+    /// for bit; on an error the target is a copy of the base.
+    #[test]
+    fn rebuilt_in_place_equals_rebuilt_anew() {
+        let kd = Vec3::new(0.6, 0.35, 0.8);
+        let albedo = [0.93, 0.71, 0.98];
+        let sigma_t = [2.0, 13.0, 0.7];
+        let mut out = Profile::from_reflectance_with(
+            ProfileModel::Burley(BurleyFit::Searchlight),
+            Vec3::splat(0.5),
+            Distance::MeanFreePath(Vec3::ONE),
+            1.5,
+        )
+        .unwrap();
+        for model in ProfileModel::ALL {
+            let base = Profile::from_reflectance_with(
+                model,
+                Vec3::new(0.5, 0.4, 0.3),
+                Distance::MeanFreePath(Vec3::splat(0.1)),
+                1.3,
+            )
+            .unwrap();
+            base.rebuild_into(&mut out, None, albedo, sigma_t).unwrap();
+            assert_eq!(
+                out,
+                base.with_albedo_and_extinction(albedo, sigma_t).unwrap()
+            );
+            base.rebuild_into(&mut out, Some(kd), albedo, sigma_t)
+                .unwrap();
+            let want = base
+                .with_reflectance_albedo_and_extinction(kd, albedo, sigma_t)
+                .unwrap();
+            assert_eq!(out, want, "{model:?}");
+            let bad = [2.0, f64::NAN, 0.7];
+            let err = base
+                .rebuild_into(&mut out, Some(kd), albedo, bad)
+                .unwrap_err();
+            assert!(
+                matches!(
+                    err,
+                    ParamError::NotPositive {
+                        name: "sigma_t",
+                        ..
+                    }
+                ),
+                "{err:?}"
+            );
+            assert_eq!(out, base, "{model:?}");
+        }
     }
 }

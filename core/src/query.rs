@@ -374,17 +374,34 @@ impl IrradianceCache {
         profile: &Profile,
         local: LocalTerm,
     ) -> Result<QueryPlan, QueryError> {
+        let mut out = *plan;
+        self.replan_into(&mut out, profile, local)?;
+        Ok(out)
+    }
+
+    /// [`IrradianceCache::replan`] in place: `plan` (made on this cache) becomes the plan of
+    /// `profile` and `local` with the same settings, the same bits as `replan` gives. For a
+    /// material that varies over the surface, one plan kept per thread and re-made at each
+    /// point is not copied at each point. On an error (a bad `local`) `plan` is unchanged.
+    #[inline]
+    pub fn replan_into(
+        &self,
+        plan: &mut QueryPlan,
+        profile: &Profile,
+        local: LocalTerm,
+    ) -> Result<(), QueryError> {
         check_local(local)?;
         debug_assert_eq!(
             plan.params.area_scale,
             reciprocal_pow2(self.mean_area()),
             "replan with a plan of another cache"
         );
-        let mut params = plan.params;
+        // Every plan's kernel is its α's (as `plan` builds it).
         if local.alpha().to_bits() != plan.local.alpha().to_bits() {
-            params.kernel = Kernel::new(local.alpha());
+            plan.params.kernel = Kernel::new(local.alpha());
         }
-        Ok(self.plan_material(params, plan.method, profile, local))
+        self.set_material(plan, profile, local);
+        Ok(())
     }
 
     /// A plan from the settings' and the cache's part (`params`) and the material.
@@ -396,18 +413,25 @@ impl IrradianceCache {
         profile: &Profile,
         local: LocalTerm,
     ) -> QueryPlan {
-        let profile = profile.for_sample_area(self.mean_area());
-        let rd_zero = profile.rd_zero().to_array();
-        QueryPlan {
-            profile,
+        let mut plan = QueryPlan {
+            profile: *profile,
             local,
             method,
-            rd_zero,
-            params: Params {
-                rd_scale: rd_zero.map(reciprocal_pow2),
-                ..params
-            },
-        }
+            rd_zero: [0.0; 3],
+            params,
+        };
+        self.set_material(&mut plan, profile, local);
+        plan
+    }
+
+    /// Writes the material's part of `plan`: the profile (capped for this cache's sample area),
+    /// Rd(0) and N10's power-of-two scales of it, and the local term.
+    #[inline]
+    fn set_material(&self, plan: &mut QueryPlan, profile: &Profile, local: LocalTerm) {
+        plan.profile = profile.for_sample_area(self.mean_area());
+        plan.rd_zero = plan.profile.rd_zero().to_array();
+        plan.params.rd_scale = plan.rd_zero.map(reciprocal_pow2);
+        plan.local = local;
     }
 
     /// [`IrradianceCache::query_with_stats`] with the material's work done once
@@ -546,15 +570,19 @@ fn pow2_clamped(v: f64) -> f32 {
 /// 2^−⌈log₂ v⌉ for positive finite v, clamped to [2⁻¹²⁶, 2¹²⁶] (1 for 0): v times it is in
 /// (1/2, 1] unless v is subnormal (then below 1) or above 2¹²⁶ (then below 4). Scaling by a
 /// power of two is exact, so N10's scaled sums lose no digits to it.
+#[inline]
 fn reciprocal_pow2(v: f32) -> f32 {
-    if !(v > 0.0 && v.is_finite()) {
+    let bits = v.to_bits();
+    // Positive finite f32s, subnormals included, are the bit patterns 1 ..= 0x7f7f_ffff (one
+    // comparison instead of a class test).
+    if bits.wrapping_sub(1) >= 0x7f7f_ffff {
         return 1.0;
     }
-    // Through f64, where every positive f32 (subnormals included) is normal.
-    let bits = f64::from(v).to_bits();
-    let floor = ((bits >> 52) & 0x7ff) as i32 - 1023;
-    let ceil = floor + i32::from(bits & ((1 << 52) - 1) != 0);
-    crate::math::pow2i((-ceil).clamp(-126, 126))
+    // From the bits: ⌊log₂ v⌋ is the exponent, one more unless the mantissa is 0. A subnormal
+    // reads as 2⁻¹²⁷·(1 + m) and gives −126, which the clamp gives its true ⌈log₂ v⌉ anyway.
+    // So ⌈log₂ v⌉ ∈ [−126, 128], and only the lower end of −⌈log₂ v⌉ needs clamping.
+    let ceil = (bits >> 23) as i32 - 127 + i32::from(bits & 0x7f_ffff != 0);
+    crate::math::pow2i((-ceil).max(-126))
 }
 
 fn split_result(sums: Sums, local_irradiance: Vec3, k: Vec3) -> Exitance {
@@ -575,3 +603,45 @@ const _: () = {
     assert!(offset_of!(Exitance, local) == 12 && offset_of!(Exitance, global) == 24);
     assert!(offset_of!(Exitance, local_irradiance) == 36 && offset_of!(Exitance, refine) == 48);
 };
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use super::*;
+
+    /// Against ⌈log₂ v⌉ found by doubling in f64 (every f32 is exact there): normal and
+    /// subnormal values, powers of two and their neighbours, and the non-positive, infinite
+    /// and NaN inputs that give 1.
+    #[test]
+    fn reciprocal_pow2_is_two_to_minus_the_ceiling_of_log2() {
+        let oracle = |v: f32| {
+            let v = f64::from(v);
+            let mut ceil = 0i32;
+            while f64::powi(2.0, ceil) < v {
+                ceil += 1;
+            }
+            while f64::powi(2.0, ceil - 1) >= v {
+                ceil -= 1;
+            }
+            f64::powi(2.0, (-ceil).clamp(-126, 126)) as f32
+        };
+        let mut values = alloc::vec::Vec::new();
+        for k in -149..=127 {
+            let p = f64::powi(2.0, k) as f32;
+            values.extend([
+                p,
+                f32::from_bits(p.to_bits() + 1),
+                f32::from_bits(p.to_bits() - 1),
+            ]);
+            values.push(p * 1.37);
+        }
+        values.extend([f32::MIN_POSITIVE, f32::MAX, 1e-45, 3.0e38, 0.3, 7.0]);
+        for v in values.into_iter().filter(|v| *v > 0.0 && v.is_finite()) {
+            assert_eq!(reciprocal_pow2(v), oracle(v), "{v:e}");
+        }
+        for v in [0.0, -0.0, -1.0, f32::INFINITY, f32::NAN] {
+            assert_eq!(reciprocal_pow2(v), 1.0, "{v}");
+        }
+    }
+}

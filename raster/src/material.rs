@@ -551,21 +551,31 @@ impl TranslucentShader {
     /// The material at texture coordinate `uv` (ignored when nothing is textured).
     #[inline]
     pub fn at(&self, uv: Vec2) -> Result<PointMaterial, ParamError> {
+        let mut out = PointMaterial {
+            profile: *self.base_profile(),
+            kd: None,
+        };
+        self.at_into(uv, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`TranslucentShader::at`] written into `out`, the same bits: for a caller that keeps
+    /// one point's material per thread rather than moving a new one at every point. On an
+    /// error `out` holds the base profile.
+    #[inline]
+    pub fn at_into(&self, uv: Vec2, out: &mut PointMaterial) -> Result<(), ParamError> {
         let Some((base, kd, distance, log_span)) = self.reflectance() else {
-            return Ok(PointMaterial {
+            *out = PointMaterial {
                 profile: *self.base_profile(),
                 kd: None,
-            });
+            };
+            return Ok(());
         };
         let (kd_value, albedo, sigma_t) = inputs_at(kd, distance, log_span, uv);
-        let profile = match kd_value {
-            Some(kd) => base.with_reflectance_albedo_and_extinction(kd, albedo, sigma_t)?,
-            None => base.with_albedo_and_extinction(albedo, sigma_t)?,
-        };
-        Ok(PointMaterial {
-            profile,
-            kd: kd_value,
-        })
+        out.kd = None;
+        base.rebuild_into(&mut out.profile, kd_value, albedo, sigma_t)?;
+        out.kd = kd_value;
+        Ok(())
     }
 
     /// The local-integral source for smoothing radius `alpha` and threshold `ell_min`: for a

@@ -805,7 +805,9 @@ fn planned_queries_equal_plain_ones_bit_for_bit() {
 
 /// A plan re-made for another material at each point ([`IrradianceCache::replan`], what a
 /// texture-mapped material does) is the plan made from scratch: the same results, bit for bit,
-/// for every method and model, with another α as well as the same; a bad K still fails.
+/// for every method and model, with another α as well as the same; a bad K still fails. So is
+/// one plan re-made in place from material to material ([`IrradianceCache::replan_into`]),
+/// and a bad K leaves it as it was.
 #[test]
 fn replanned_queries_equal_plain_ones_bit_for_bit() {
     let cache = IrradianceCache::build(&sphere_samples(2000, 1.0, 8)).unwrap();
@@ -814,6 +816,7 @@ fn replanned_queries_equal_plain_ones_bit_for_bit() {
     for method in Method::ALL {
         let s = settings(method, 0.4, 1e-4);
         let template = cache.plan(&base, base_local, &s).unwrap();
+        let mut in_place = template;
         for model in ProfileModel::ALL {
             for (i, (ell, alpha)) in [(0.02, 0.04), (0.2, 0.04), (0.05, 0.07)]
                 .into_iter()
@@ -829,10 +832,20 @@ fn replanned_queries_equal_plain_ones_bit_for_bit() {
                 let local = term(alpha, Vec3::new(0.1, 0.2, 0.3));
                 let replanned = cache.replan(&template, &p, local).unwrap();
                 assert_eq!(replanned.local(), local);
+                cache.replan_into(&mut in_place, &p, local).unwrap();
+                let bad = term(alpha, Vec3::new(f32::NAN, 0.0, 0.0));
+                assert_eq!(
+                    cache.replan_into(&mut in_place, &base, bad),
+                    Err(QueryError::InvalidLocalIntegral)
+                );
+                assert_eq!(in_place.local(), local);
+                assert_eq!(in_place.profile(), replanned.profile());
                 for x in query_points(40, 10 + i as u64) {
                     let want = cache.query(&p, &point(x), local, &s).unwrap();
                     let got = cache.query_planned(&replanned, &point(x), &mut NoStats);
                     assert_eq!(got.unwrap(), want, "{method:?} {model:?} ℓ {ell} α {alpha}");
+                    let got = cache.query_planned(&in_place, &point(x), &mut NoStats);
+                    assert_eq!(got.unwrap(), want, "in place: {method:?} {model:?} ℓ {ell}");
                 }
             }
         }

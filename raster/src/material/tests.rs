@@ -484,3 +484,60 @@ fn parameters_at_match_the_profile_at_the_point() {
         }
     }
 }
+
+/// The material written into one kept value, point after point and material after material
+/// (textured K_d, radius, both, or neither; every model; either distance), is `at`'s, bit for
+/// bit.
+#[test]
+fn material_written_in_place_equals_material_made_anew() {
+    let kd = texture(&[Vec3::new(0.1, 0.5, 0.9), Vec3::new(0.7, 0.3, 0.05)], 2);
+    let ell = texture(&[Vec3::splat(0.2), Vec3::new(0.9, 0.4, 0.1)], 2);
+    let mut kept = translucent(Medium::Reflectance {
+        kd: ColorParam::Constant(Vec3::splat(0.5)),
+        distance: Distance::MeanFreePath(ScalarParam::Constant(Vec3::ONE)),
+        eta: 1.3,
+    })
+    .at(Vec2::ZERO)
+    .unwrap();
+    let mut checked = 0;
+    for model in ProfileModel::ALL {
+        for diffuse in [false, true] {
+            for (textured_kd, textured_ell) in [(true, true), (true, false), (false, true)] {
+                let param = if textured_ell {
+                    ScalarParam::Texture {
+                        texture: ell.clone(),
+                        min: 0.01,
+                        max: 2.0,
+                    }
+                } else {
+                    ScalarParam::Constant(Vec3::new(0.3, 0.2, 0.1))
+                };
+                let shader = translucent_with(
+                    model,
+                    Medium::Reflectance {
+                        kd: if textured_kd {
+                            ColorParam::Texture(kd.clone())
+                        } else {
+                            ColorParam::Constant(Vec3::new(0.8, 0.6, 0.4))
+                        },
+                        distance: if diffuse {
+                            Distance::DiffuseMeanFreePath(param)
+                        } else {
+                            Distance::MeanFreePath(param)
+                        },
+                        eta: 1.4,
+                    },
+                );
+                for u in [0.1, 0.3, 0.62, 0.9] {
+                    let uv = Vec2::new(u, 1.0 - u);
+                    let want = shader.at(uv).unwrap();
+                    shader.at_into(uv, &mut kept).unwrap();
+                    assert_eq!(kept.profile, want.profile, "{} {u}", model.name());
+                    assert_eq!(kept.kd, want.kd, "{} {u}", model.name());
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(checked, ProfileModel::ALL.len() * 2 * 3 * 4);
+}

@@ -8,6 +8,7 @@
 //!   normalised Blinn–Phong highlight.
 //! - Lambert: L = albedo / π · E(x).
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::{Mat4, Vec2, Vec3};
@@ -53,7 +54,12 @@ pub struct ObjectCache {
     /// When the material varies over the surface: a plan of its base profile, whose settings
     /// checks and cache scales each shading point reuses ([`IrradianceCache::replan`]).
     pub textured_plan: Option<QueryPlan>,
+    /// Unique among the caches of the process: names this cache's plan in a thread's scratch.
+    id: u64,
 }
+
+/// The next [`ObjectCache`]'s id.
+static NEXT_CACHE_ID: AtomicU64 = AtomicU64::new(0);
 
 /// A material that does not vary over the surface, resolved once for an object.
 #[derive(Clone, Copy, Debug)]
@@ -130,8 +136,22 @@ impl ObjectCache {
                 .map(|_| edge_refined::layout(alpha)),
             uniform,
             textured_plan,
+            id: NEXT_CACHE_ID.fetch_add(1, Ordering::Relaxed),
         })
     }
+}
+
+/// A texture-mapped material's working values, kept by a thread and re-made in place at each
+/// point ([`TranslucentShader::at_into`], [`IrradianceCache::replan_into`]) rather than built
+/// anew and moved: they are a few hundred bytes.
+#[derive(Clone, Debug)]
+pub(crate) struct TexturedScratch {
+    /// The [`ObjectCache`] they belong to.
+    cache_id: u64,
+    /// The material at the point.
+    point: PointMaterial,
+    /// The query plan at the point (from the object's template).
+    plan: Option<QueryPlan>,
 }
 
 /// Everything a pixel's value is made of (coverage-weighted sums over its surfaces).
@@ -237,6 +257,8 @@ pub struct PixelScratch {
     pub groups: GroupScratch,
     /// The last triangle's shared attributes, kept from pixel to pixel.
     pub(crate) triangle: TriangleSetup,
+    /// The last texture-mapped material's point and plan, re-made in place at each point.
+    pub(crate) textured: Option<TexturedScratch>,
 }
 
 /// The read-only state every pixel is shaded from.
@@ -293,6 +315,7 @@ impl Shading<'_> {
             shadows,
             groups,
             triangle,
+            textured,
             ..
         } = scratch;
         let mut value = PixelValue::default();
@@ -305,7 +328,7 @@ impl Shading<'_> {
             let seed = group.seed(splitmix64(pixel_index * 16 + group.source as u64));
             let timed = S::TIMED && self.caches[fragment.key as usize].is_some();
             let start = timed.then(Instant::now);
-            let s = self.surface(fragment, seed, shadows, triangle, stats)?;
+            let s = self.surface(fragment, seed, shadows, triangle, textured, stats)?;
             if let Some(start) = start {
                 stats.translucent_time(start.elapsed());
             }
@@ -329,6 +352,7 @@ impl Shading<'_> {
         seed: u64,
         shadows: &mut ShadowHints,
         triangle: &mut TriangleSetup,
+        textured: &mut Option<TexturedScratch>,
         stats: &mut S,
     ) -> Result<Surface, RenderError> {
         let prep = self.prep;
@@ -358,17 +382,27 @@ impl Shading<'_> {
                 })?;
                 // K by quadrature at every point (a measurement option) bypasses the plan.
                 let uniform = oc.uniform.as_ref().filter(|_| !self.exact_local_integral);
-                let at_point;
-                let point = match uniform {
-                    Some(u) => &u.point,
+                let (point, textured_plan) = match uniform {
+                    Some(u) => (&u.point, None),
                     None => {
-                        at_point = shader.at(uv).map_err(|e| {
+                        let scratch = match textured {
+                            Some(t) if t.cache_id == oc.id => t,
+                            _ => textured.insert(TexturedScratch {
+                                cache_id: oc.id,
+                                point: PointMaterial {
+                                    profile: *shader.base_profile(),
+                                    kd: None,
+                                },
+                                plan: oc.textured_plan,
+                            }),
+                        };
+                        shader.at_into(uv, &mut scratch.point).map_err(|e| {
                             RenderError::Material(MaterialError::Params {
                                 material: shader.name.clone(),
                                 source: e,
                             })
                         })?;
-                        &at_point
+                        (&scratch.point, scratch.plan.as_mut())
                     }
                 };
                 let method = self.settings.method;
@@ -413,14 +447,14 @@ impl Shading<'_> {
                             (Some(source), None) => source.lookup(point),
                             (None, _) => LocalTerm::NONE,
                         };
-                        let m = match &oc.textured_plan {
-                            Some(template) => oc
+                        let m = match textured_plan {
+                            Some(plan) => oc
                                 .cache
-                                .replan(template, &point.profile, local)
-                                .and_then(|plan| {
+                                .replan_into(plan, &point.profile, local)
+                                .and_then(|()| {
                                     super::simd::query_planned(
                                         &oc.cache,
-                                        &plan,
+                                        plan,
                                         &shading_point,
                                         stats,
                                     )
