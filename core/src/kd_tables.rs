@@ -151,6 +151,14 @@ impl LocalIntegralByKd {
         self
     }
 
+    /// True when a lookup at `kd`, `ell_u` reads the dense grid of
+    /// [`LocalIntegralByKd::with_range`] rather than the tables.
+    pub fn in_grid(&self, kd: Vec3, ell_u: Vec3) -> bool {
+        self.grid
+            .as_ref()
+            .is_some_and(|g| self.lookup_in_grid(g, kd, ell_u).is_some())
+    }
+
     /// Bytes held by the dense grid of [`LocalIntegralByKd::with_range`] (0 without one).
     pub fn grid_bytes(&self) -> usize {
         self.grid.as_ref().map_or(0, KdGrid::bytes)
@@ -406,6 +414,7 @@ mod tests {
                     let kd = kd.clamp(Vec3::splat(0.2), Vec3::splat(0.7));
                     let ell = 0.01 * 40f32.powf(j as f32 / 60.0);
                     let ell = Vec3::new(ell, ell, ell * 0.9f32.max(0.01 / ell));
+                    assert!(ranged.in_grid(kd, ell) && !plain.in_grid(kd, ell));
                     let (got, want) = (ranged.lookup(kd, ell), plain.lookup(kd, ell));
                     worst = worst.max(((got - want) / want).abs().max_element());
                 }
@@ -422,6 +431,7 @@ mod tests {
                 (Vec3::splat(0.5), Vec3::splat(f32::INFINITY)),
                 (Vec3::splat(0.5), Vec3::splat(alpha / 2048.0)),
             ] {
+                assert!(!ranged.in_grid(kd, ell), "{kd} {ell}");
                 assert_eq!(
                     ranged.lookup(kd, ell).to_array().map(f32::to_bits),
                     plain.lookup(kd, ell).to_array().map(f32::to_bits),

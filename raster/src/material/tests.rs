@@ -541,3 +541,56 @@ fn material_written_in_place_equals_material_made_anew() {
     }
     assert_eq!(checked, ProfileModel::ALL.len() * 2 * 3 * 4);
 }
+
+/// Every point of a texture-mapped K_d reads K from the dense grid over the range the textures
+/// reach (not the slower tables), with either distance textured or constant, every model.
+#[test]
+fn textured_points_fall_inside_the_k_grid() {
+    let kd = texture(&[Vec3::new(0.1, 0.5, 0.9), Vec3::new(0.7, 0.3, 0.05)], 2);
+    let ell = texture(&[Vec3::splat(0.0), Vec3::new(1.0, 0.4, 0.1)], 2);
+    let alpha = 0.04;
+    for model in ProfileModel::ALL {
+        for diffuse in [false, true] {
+            for textured_ell in [false, true] {
+                let param = if textured_ell {
+                    ScalarParam::Texture {
+                        texture: ell.clone(),
+                        min: 0.005,
+                        max: 0.5,
+                    }
+                } else {
+                    ScalarParam::Constant(Vec3::new(0.3, 0.2, 0.1))
+                };
+                let shader = translucent_with(
+                    model,
+                    Medium::Reflectance {
+                        kd: ColorParam::Texture(kd.clone()),
+                        distance: if diffuse {
+                            Distance::DiffuseMeanFreePath(param)
+                        } else {
+                            Distance::MeanFreePath(param)
+                        },
+                        eta: 1.4,
+                    },
+                );
+                let LocalIntegral::ByKd(tables) = shader.local_term(alpha, alpha / 1024.0).unwrap()
+                else {
+                    panic!("a textured K_d takes the tables over K_d");
+                };
+                assert_eq!(tables.validate(), Ok(()));
+                for i in 0..=20 {
+                    for j in 0..=20 {
+                        let uv = Vec2::new(i as f32 / 20.0, j as f32 / 20.0);
+                        let point = shader.at(uv).unwrap();
+                        let (kd, ell) = (point.kd.unwrap(), point.profile.mean_free_path());
+                        assert!(
+                            tables.in_grid(kd, ell),
+                            "{} diffuse {diffuse}: {kd} {ell}",
+                            model.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
