@@ -32,6 +32,27 @@ fn translucent_with(model: ProfileModel, medium: Medium) -> TranslucentShader {
     }
 }
 
+/// A material of `model` given by K_d and a distance: ℓ_d (`diffuse`) or ℓ_u, η 1.4.
+fn reflectance_with(
+    model: ProfileModel,
+    kd: ColorParam,
+    distance: ScalarParam,
+    diffuse: bool,
+) -> TranslucentShader {
+    translucent_with(
+        model,
+        Medium::Reflectance {
+            kd,
+            distance: if diffuse {
+                Distance::DiffuseMeanFreePath(distance)
+            } else {
+                Distance::MeanFreePath(distance)
+            },
+            eta: 1.4,
+        },
+    )
+}
+
 #[test]
 fn constant_reflectance_matches_the_core() {
     let kd = Vec3::new(0.8, 0.5, 0.3);
@@ -337,22 +358,12 @@ fn smallest_decay_length_over_textures_is_the_surface_minimum() {
             } else {
                 ScalarParam::Constant(Vec3::splat(0.05))
             };
-            let shader = translucent_with(
-                model,
-                Medium::Reflectance {
-                    kd: if kd_textured {
-                        ColorParam::Texture(kd.clone())
-                    } else {
-                        ColorParam::Constant(Vec3::new(0.3, 0.6, 0.9))
-                    },
-                    distance: if diffuse {
-                        Distance::DiffuseMeanFreePath(ell)
-                    } else {
-                        Distance::MeanFreePath(ell)
-                    },
-                    eta: 1.4,
-                },
-            );
+            let kd = if kd_textured {
+                ColorParam::Texture(kd.clone())
+            } else {
+                ColorParam::Constant(Vec3::new(0.3, 0.6, 0.9))
+            };
+            let shader = reflectance_with(model, kd, ell, diffuse);
             let bound = shader.smallest_diffuse_mean_free_path();
             // 2 × 2 texels, centres at 1/4 and 3/4: sampled at 1/64 steps, centres included.
             let mut brute = Vec3::INFINITY;
@@ -451,18 +462,7 @@ fn parameters_at_match_the_profile_at_the_point() {
                 min: 0.01,
                 max: 2.0,
             };
-            let shader = translucent_with(
-                model,
-                Medium::Reflectance {
-                    kd: ColorParam::Texture(kd.clone()),
-                    distance: if diffuse {
-                        Distance::DiffuseMeanFreePath(param)
-                    } else {
-                        Distance::MeanFreePath(param)
-                    },
-                    eta: 1.4,
-                },
-            );
+            let shader = reflectance_with(model, ColorParam::Texture(kd.clone()), param, diffuse);
             for u in [0.1, 0.3, 0.62, 0.9] {
                 let uv = Vec2::new(u, 0.5);
                 let profile = shader.at(uv).unwrap().profile;
@@ -512,22 +512,12 @@ fn material_written_in_place_equals_material_made_anew() {
                 } else {
                     ScalarParam::Constant(Vec3::new(0.3, 0.2, 0.1))
                 };
-                let shader = translucent_with(
-                    model,
-                    Medium::Reflectance {
-                        kd: if textured_kd {
-                            ColorParam::Texture(kd.clone())
-                        } else {
-                            ColorParam::Constant(Vec3::new(0.8, 0.6, 0.4))
-                        },
-                        distance: if diffuse {
-                            Distance::DiffuseMeanFreePath(param)
-                        } else {
-                            Distance::MeanFreePath(param)
-                        },
-                        eta: 1.4,
-                    },
-                );
+                let kd = if textured_kd {
+                    ColorParam::Texture(kd.clone())
+                } else {
+                    ColorParam::Constant(Vec3::new(0.8, 0.6, 0.4))
+                };
+                let shader = reflectance_with(model, kd, param, diffuse);
                 for u in [0.1, 0.3, 0.62, 0.9] {
                     let uv = Vec2::new(u, 1.0 - u);
                     let want = shader.at(uv).unwrap();
@@ -561,18 +551,8 @@ fn textured_points_fall_inside_the_k_grid() {
                 } else {
                     ScalarParam::Constant(Vec3::new(0.3, 0.2, 0.1))
                 };
-                let shader = translucent_with(
-                    model,
-                    Medium::Reflectance {
-                        kd: ColorParam::Texture(kd.clone()),
-                        distance: if diffuse {
-                            Distance::DiffuseMeanFreePath(param)
-                        } else {
-                            Distance::MeanFreePath(param)
-                        },
-                        eta: 1.4,
-                    },
-                );
+                let shader =
+                    reflectance_with(model, ColorParam::Texture(kd.clone()), param, diffuse);
                 let LocalIntegral::ByKd(tables) = shader.local_term(alpha, alpha / 1024.0).unwrap()
                 else {
                     panic!("a textured K_d takes the tables over K_d");
