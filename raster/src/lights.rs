@@ -7,9 +7,9 @@
 //! makes it deliver the same E as a point light of intensity I when fully visible; its soft
 //! shadows come from `samples` stratified directions in the cone it subtends, each traced.
 //! A rect light of area A has radiance L = I/A (I its intensity along its normal), and is
-//! sampled at stratified points on its area ([`rect`]); an environment is a radiance at
+//! sampled at stratified points on its area (`lights/rect.rs`); an environment is a radiance at
 //! infinity, constant or a lat-long map, sampled by cosine-weighted or luminance-importance
-//! directions ([`environment`], [`EnvironmentMap`]). Every area light draws its `samples`
+//! directions (`lights/environment.rs`, [`EnvironmentMap`]). Every area light draws its `samples`
 //! variates from the same stratified square ([`strata`]), rotated per point by a hash.
 //!
 //! Shadow rays start off the surface (see [`offset_origin`]) and test every triangle of the

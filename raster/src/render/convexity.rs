@@ -49,7 +49,7 @@ const LEAF: usize = 8;
 /// True if no ray leaving a point of the mesh towards a light (from the side the light is on)
 /// can hit the mesh again: every vertex lies behind or on the plane of every face (within the
 /// tolerance), which includes flat meshes. Meshes too large for the exhaustive test within
-/// [`WORK_LIMIT`], and meshes with non-finite positions, are taken to shadow themselves.
+/// `WORK_LIMIT`, and meshes with non-finite positions, are taken to shadow themselves.
 pub fn cannot_shadow_itself(mesh: &Mesh) -> bool {
     cannot_shadow_itself_within(mesh, WORK_LIMIT)
 }
