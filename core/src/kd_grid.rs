@@ -72,7 +72,7 @@ pub(crate) struct GridPlace {
 impl KdGrid {
     /// The grid over K_d levels `first_level ..= last_level` (indices into `tables`) and
     /// ℓ_u ∈ [`ell_lo`, `ell_hi`] for tables of smoothing radius `alpha` whose first node is
-    /// at q = `first_node`; each `level_kd[i]` is level i's K_d. `None` when the range is empty,
+    /// at q = `first_node`; `level_kd(i)` is level i's K_d. `None` when the range is empty,
     /// not finite, or wider than 48 octaves.
     pub(crate) fn new(
         tables: &[LocalIntegralTable],

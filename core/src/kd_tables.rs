@@ -69,6 +69,16 @@ struct LevelWeights {
     inv_width: f32,
 }
 
+impl LevelWeights {
+    /// How far `kd` (clamped as the levels are) lies from level i to level i + 1, in [0, 1].
+    /// The end levels sit at the clamp bounds, not at 0 and 1: the fraction comes from the
+    /// levels' own K_d.
+    #[inline]
+    fn fraction(&self, kd: f32) -> f32 {
+        ((kd - self.kd_lo) * self.inv_width).clamp(0.0, 1.0)
+    }
+}
+
 impl LocalIntegralByKd {
     /// Intervals between the K_d levels (the tables are one more).
     pub const LEVELS: usize = 64;
@@ -214,9 +224,7 @@ impl LocalIntegralByKd {
             let kd_c = kd[c].clamp(LEVEL_KD_MIN, LEVEL_KD_MAX);
             let i = level_of(kd_c);
             let place = grid.place(i, row)?;
-            let w = self.weights[i];
-            let s = ((kd_c - w.kd_lo) * w.inv_width).clamp(0.0, 1.0);
-            k[c] = grid.share(place, s) * kd_c;
+            k[c] = grid.share(place, self.weights[i].fraction(kd_c)) * kd_c;
         }
         Some(Vec3::from_array(k))
     }
@@ -250,8 +258,7 @@ impl LocalIntegralByKd {
         let e = math::exp_nonpositive_poly_8(exponents);
         Vec3::from_array(core::array::from_fn(|c| {
             let (kd_c, w) = interval[c];
-            // The end levels sit at the clamp bounds, not at 0 and 1: t from the levels' own K_d.
-            let t = ((kd_c - w.kd_lo) * w.inv_width).clamp(0.0, 1.0);
+            let t = w.fraction(kd_c);
             // The fraction K / K_d is what varies slowly: at low K_d, K is nearly proportional
             // to K_d and linear interpolation of K itself erred by 2.7% at K_d = 0.005.
             let lo = factors[2 * c] * e[2 * c] * w.inv_kd_lo;

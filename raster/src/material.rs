@@ -385,8 +385,11 @@ fn scalar_range(p: &ScalarParam) -> (Vec3, Vec3) {
         ScalarParam::Texture { texture, .. } => {
             let (lo, hi) = texel_range(texture);
             // min·(max/min)^t is monotone in t: the extremes are the ends of the texel range.
-            let at = |t: Vec3| scalar_at_value(p, log_span(p), t);
-            (at(lo).min(at(hi)), at(lo).max(at(hi)))
+            let (a, b) = (
+                scalar_at_value(p, log_span(p), lo),
+                scalar_at_value(p, log_span(p), hi),
+            );
+            (a.min(b), a.max(b))
         }
     }
 }
@@ -400,8 +403,7 @@ fn smallest_scalar(p: &ScalarParam) -> Vec3 {
 /// (bilinear samples lie between the texels).
 fn kd_range(texture: &Texture) -> (f32, f32) {
     let (lo, hi) = texel_range(texture);
-    let clamp = |v: f32| v.clamp(0.001, 0.999);
-    (clamp(lo.min_element()), clamp(hi.max_element()))
+    (clamp_kd(lo).min_element(), clamp_kd(hi).max_element())
 }
 
 /// The range of ℓ_u over the surface, all channels, for K_d ∈ `kd`: the distance parameter's
@@ -489,8 +491,7 @@ impl TranslucentShader {
                 KdSource::Constant { .. } => vec![Vec3::splat(0.5)],
                 KdSource::Texture { texture, .. } => {
                     let (lo, hi) = texel_range(texture);
-                    let clamp = |v: Vec3| v.clamp(Vec3::splat(0.001), Vec3::splat(0.999));
-                    let (lo, hi) = (clamp(lo), clamp(hi));
+                    let (lo, hi) = (clamp_kd(lo), clamp_kd(hi));
                     (0..=64).map(|i| lo.lerp(hi, i as f32 / 64.0)).collect()
                 }
             };
@@ -512,9 +513,7 @@ impl TranslucentShader {
         let albedo: [f64; 3] = match kd {
             KdSource::Constant { albedo, .. } => *albedo,
             KdSource::Texture { texture, .. } => {
-                let lo = texel_range(texture)
-                    .0
-                    .clamp(Vec3::splat(0.001), Vec3::splat(0.999));
+                let lo = clamp_kd(texel_range(texture).0);
                 kd.albedos(lo).0
             }
         };
