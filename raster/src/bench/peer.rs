@@ -152,6 +152,8 @@ pub struct PeerRow {
     pub process_cpu_us: f64,
     /// Profile evaluations per lookup.
     pub evaluations: f64,
+    /// Internal nodes opened (examined eight children at a time) per lookup.
+    pub nodes: f64,
 }
 
 /// The outcome of the peer comparison.
@@ -339,17 +341,21 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
             if rows[i].is_none() {
                 let (rel_rmse, mean_relative) = relative_errors(&exitance(&r), &reference, &mask);
                 let t = r.stats.traversal.unwrap_or_default();
+                let per_query = |n: u64| {
+                    if t.queries == 0 {
+                        0.0
+                    } else {
+                        n as f64 / t.queries as f64
+                    }
+                };
                 rows[i] = Some(PeerRow {
                     epsilon,
                     rel_rmse,
                     mean_relative,
                     cpu_us: 0.0,
                     process_cpu_us: f64::NAN,
-                    evaluations: if t.queries == 0 {
-                        0.0
-                    } else {
-                        t.profile_evaluations() as f64 / t.queries as f64
-                    },
+                    evaluations: per_query(t.profile_evaluations()),
+                    nodes: per_query(t.nodes_opened),
                 });
             }
         }
@@ -369,11 +375,12 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
         .collect();
     for r in &rows {
         log(&format!(
-            "peer: hierarchical ε {:<6} relRMSE {:.3}%, mean rel. {:.3}%, {:.1} evaluations, {:.3} µs/lookup ({:.3} process CPU)",
+            "peer: hierarchical ε {:<6} relRMSE {:.3}%, mean rel. {:.3}%, {:.1} evaluations, {:.1} nodes, {:.3} µs/lookup ({:.3} process CPU)",
             r.epsilon,
             r.rel_rmse * 100.0,
             r.mean_relative * 100.0,
             r.evaluations,
+            r.nodes,
             r.cpu_us,
             r.process_cpu_us
         ));
@@ -486,13 +493,13 @@ pub fn markdown(report: &PeerReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "## Peer comparison\n\nSphere, {}², one lookup per pixel (aa 1), {} samples, one thread; {} lookups per render, {} pixels in the 3 × 3-eroded mask. Error of the exitance over the mask against the exhaustive sum on the same samples: relRMSE = RMSE / mean, and the mean relative error. CPU per lookup: the clock time of the translucent points, median over {} interleaved rounds; *process CPU* is the whole render's user + system time per lookup (floor pixels and set-up included, 10 ms ticks), a bound that time spent waiting for a core does not inflate.\n\n| ε | relRMSE | mean rel. | evaluations / lookup | CPU µs / lookup | process CPU µs / lookup |\n|---:|---:|---:|---:|---:|---:|",
+        "## Peer comparison\n\nSphere, {}², one lookup per pixel (aa 1), {} samples, one thread; {} lookups per render, {} pixels in the 3 × 3-eroded mask. Error of the exitance over the mask against the exhaustive sum on the same samples: relRMSE = RMSE / mean, and the mean relative error. CPU per lookup: the clock time of the translucent points, median over {} interleaved rounds; *process CPU* is the whole render's user + system time per lookup (floor pixels and set-up included, 10 ms ticks), a bound that time spent waiting for a core does not inflate.\n\n| ε | relRMSE | mean rel. | evaluations / lookup | nodes / lookup | CPU µs / lookup | process CPU µs / lookup |\n|---:|---:|---:|---:|---:|---:|---:|",
         c.resolution, report.samples, report.lookups, report.pixels, c.rounds,
     );
     for r in &report.rows {
         let _ = writeln!(
             s,
-            "| {} | {:.3}% | {:.3}% | {:.1} | {:.3} | {:.3} |",
+            "| {} | {:.3}% | {:.3}% | {:.1} | {:.1} | {:.3} | {:.3} |",
             if r.epsilon >= 1e6 {
                 "∞".to_string()
             } else {
@@ -501,6 +508,7 @@ pub fn markdown(report: &PeerReport) -> String {
             r.rel_rmse * 100.0,
             r.mean_relative * 100.0,
             r.evaluations,
+            r.nodes,
             r.cpu_us,
             r.process_cpu_us
         );
@@ -565,12 +573,18 @@ pub fn markdown(report: &PeerReport) -> String {
 /// `peer.csv`: one row per ε of lucent's curve.
 pub fn csv(report: &PeerReport) -> String {
     let mut s = String::from(
-        "epsilon,rel_rmse,mean_relative,evaluations_per_lookup,cpu_us_per_lookup,process_cpu_us_per_lookup\n",
+        "epsilon,rel_rmse,mean_relative,evaluations_per_lookup,nodes_per_lookup,cpu_us_per_lookup,process_cpu_us_per_lookup\n",
     );
     for r in &report.rows {
         s.push_str(&format!(
-            "{},{:.6e},{:.6e},{:.2},{:.4},{:.4}\n",
-            r.epsilon, r.rel_rmse, r.mean_relative, r.evaluations, r.cpu_us, r.process_cpu_us
+            "{},{:.6e},{:.6e},{:.2},{:.2},{:.4},{:.4}\n",
+            r.epsilon,
+            r.rel_rmse,
+            r.mean_relative,
+            r.evaluations,
+            r.nodes,
+            r.cpu_us,
+            r.process_cpu_us
         ));
     }
     s

@@ -191,7 +191,7 @@ fn quick_bench_writes_a_complete_report() {
     assert_eq!(peer_rows.len(), 3, "{peer}");
     for row in peer_rows {
         let cells: Vec<f64> = row.split(',').map(|c| c.parse().unwrap()).collect();
-        assert!(cells[..5].iter().all(|&v| v > 0.0), "{row}");
+        assert!(cells[..6].iter().all(|&v| v > 0.0), "{row}");
     }
     let labels = [
         "hierarchical eps=0.5",
