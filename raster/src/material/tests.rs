@@ -53,6 +53,19 @@ fn reflectance_with(
     )
 }
 
+/// A distance map `texture` over [min, max] where `textured`, else the constant (0.3, 0.2, 0.1).
+fn distance_param(textured: bool, texture: &Arc<Texture>, min: f32, max: f32) -> ScalarParam {
+    if textured {
+        ScalarParam::Texture {
+            texture: texture.clone(),
+            min,
+            max,
+        }
+    } else {
+        ScalarParam::Constant(Vec3::new(0.3, 0.2, 0.1))
+    }
+}
+
 #[test]
 fn constant_reflectance_matches_the_core() {
     let kd = Vec3::new(0.8, 0.5, 0.3);
@@ -503,15 +516,7 @@ fn material_written_in_place_equals_material_made_anew() {
     for model in ProfileModel::ALL {
         for diffuse in [false, true] {
             for (textured_kd, textured_ell) in [(true, true), (true, false), (false, true)] {
-                let param = if textured_ell {
-                    ScalarParam::Texture {
-                        texture: ell.clone(),
-                        min: 0.01,
-                        max: 2.0,
-                    }
-                } else {
-                    ScalarParam::Constant(Vec3::new(0.3, 0.2, 0.1))
-                };
+                let param = distance_param(textured_ell, &ell, 0.01, 2.0);
                 let kd = if textured_kd {
                     ColorParam::Texture(kd.clone())
                 } else {
@@ -542,15 +547,7 @@ fn textured_points_fall_inside_the_k_grid() {
     for model in ProfileModel::ALL {
         for diffuse in [false, true] {
             for textured_ell in [false, true] {
-                let param = if textured_ell {
-                    ScalarParam::Texture {
-                        texture: ell.clone(),
-                        min: 0.005,
-                        max: 0.5,
-                    }
-                } else {
-                    ScalarParam::Constant(Vec3::new(0.3, 0.2, 0.1))
-                };
+                let param = distance_param(textured_ell, &ell, 0.005, 0.5);
                 let shader =
                     reflectance_with(model, ColorParam::Texture(kd.clone()), param, diffuse);
                 let LocalIntegral::ByKd(tables) = shader.local_term(alpha, alpha / 1024.0).unwrap()
