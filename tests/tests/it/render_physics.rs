@@ -415,6 +415,36 @@ seed = {seed}
         bake(scene, false).unwrap()
     }
 
+    /// The plane of `m` baked once per seed, at cluster threshold `epsilon` (24² pixels),
+    /// for [`mean_bias`].
+    pub fn bake_seeds<const N: usize>(
+        m: &Material,
+        epsilon: f32,
+        seeds: [u64; N],
+    ) -> [Vec<ObjectSamples>; N] {
+        seeds.map(|seed| bake_plane(&scene(m, 0.0, "exhaustive", epsilon, 24, seed)))
+    }
+
+    /// The mean over `seeds` of `method`'s bias, each seed rendered from its set in `sets`
+    /// (from [`bake_seeds`] with the same seeds and `epsilon`).
+    pub fn mean_bias(
+        m: &Material,
+        method: &str,
+        epsilon: f32,
+        seeds: &[u64],
+        sets: &[Vec<ObjectSamples>],
+        exact_k: bool,
+    ) -> Vec3 {
+        seeds
+            .iter()
+            .zip(sets)
+            .map(|(&seed, sets)| {
+                outcome(&scene(m, 0.0, method, epsilon, 24, seed), sets, m, exact_k).bias
+            })
+            .sum::<Vec3>()
+            / seeds.len() as f32
+    }
+
     /// `sets` with every area set to the total over the count, as before per-sample areas.
     pub fn equal_areas(sets: &[ObjectSamples]) -> Vec<ObjectSamples> {
         let mut equal = sets.to_vec();
@@ -499,8 +529,7 @@ fn voronoi_areas_make_a_uniform_plane_exact() {
         ..marble()
     };
     let seeds = [1, 2];
-    let sets = seeds.map(|seed| {
-        let voronoi = bake_plane(&scene(&m, 0.0, "exhaustive", 0.05, 24, seed));
+    let sets = bake_seeds(&m, 0.05, seeds).map(|voronoi| {
         let equal = equal_areas(&voronoi);
         (voronoi, equal)
     });
@@ -558,17 +587,8 @@ fn uniform_plane_at_the_default_epsilon() {
     };
     for m in [marble, skin1(), kd_ell()] {
         let seeds = [1, 2];
-        let sets = seeds.map(|seed| bake_plane(&scene(&m, 0.0, "exhaustive", 0.5, 24, seed)));
-        let mean = |method: &str| {
-            seeds
-                .iter()
-                .zip(&sets)
-                .map(|(&seed, sets)| {
-                    outcome(&scene(&m, 0.0, method, 0.5, 24, seed), sets, &m, true).bias
-                })
-                .sum::<Vec3>()
-                / seeds.len() as f32
-        };
+        let sets = bake_seeds(&m, 0.5, seeds);
+        let mean = |method: &str| mean_bias(&m, method, 0.5, &seeds, &sets, true);
         for method in ["local-global", "edge-aware"] {
             let bias = worst(mean(method));
             assert!(
@@ -605,17 +625,8 @@ fn uniform_plane_under_normalised_diffusion() {
     use uniform_plane::*;
     let m = burley_marble();
     let seeds = [1, 2];
-    let sets = seeds.map(|seed| bake_plane(&scene(&m, 0.0, "exhaustive", 0.5, 24, seed)));
-    let mean = |method: &str, exact_k: bool| {
-        seeds
-            .iter()
-            .zip(&sets)
-            .map(|(&seed, sets)| {
-                outcome(&scene(&m, 0.0, method, 0.5, 24, seed), sets, &m, exact_k).bias
-            })
-            .sum::<Vec3>()
-            / seeds.len() as f32
-    };
+    let sets = bake_seeds(&m, 0.5, seeds);
+    let mean = |method: &str, exact_k: bool| mean_bias(&m, method, 0.5, &seeds, &sets, exact_k);
     for method in ["local-global", "edge-aware"] {
         for exact_k in [true, false] {
             let bias = worst(mean(method, exact_k));
