@@ -152,6 +152,8 @@ pub struct PeerRow {
     pub process_cpu_us: f64,
     /// Profile evaluations per lookup.
     pub evaluations: f64,
+    /// Of those, node aggregates (the fourth-order term, dearer than a sample's plain Rd).
+    pub aggregates: f64,
     /// Internal nodes opened (examined eight children at a time) per lookup.
     pub nodes: f64,
 }
@@ -355,6 +357,7 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
                     cpu_us: 0.0,
                     process_cpu_us: f64::NAN,
                     evaluations: per_query(t.profile_evaluations()),
+                    aggregates: per_query(t.aggregates),
                     nodes: per_query(t.nodes_opened),
                 });
             }
@@ -375,11 +378,12 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
         .collect();
     for r in &rows {
         log(&format!(
-            "peer: hierarchical ε {:<6} relRMSE {:.3}%, mean rel. {:.3}%, {:.1} evaluations, {:.1} nodes, {:.3} µs/lookup ({:.3} process CPU)",
+            "peer: hierarchical ε {:<6} relRMSE {:.3}%, mean rel. {:.3}%, {:.1} evaluations ({:.1} aggregates), {:.1} nodes, {:.3} µs/lookup ({:.3} process CPU)",
             r.epsilon,
             r.rel_rmse * 100.0,
             r.mean_relative * 100.0,
             r.evaluations,
+            r.aggregates,
             r.nodes,
             r.cpu_us,
             r.process_cpu_us
@@ -493,13 +497,13 @@ pub fn markdown(report: &PeerReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "## Peer comparison\n\nSphere, {}², one lookup per pixel (aa 1), {} samples, one thread; {} lookups per render, {} pixels in the 3 × 3-eroded mask. Error of the exitance over the mask against the exhaustive sum on the same samples: relRMSE = RMSE / mean, and the mean relative error. CPU per lookup: the clock time of the translucent points, median over {} interleaved rounds; *process CPU* is the whole render's user + system time per lookup (floor pixels and set-up included, 10 ms ticks), a bound that time spent waiting for a core does not inflate.\n\n| ε | relRMSE | mean rel. | evaluations / lookup | nodes / lookup | CPU µs / lookup | process CPU µs / lookup |\n|---:|---:|---:|---:|---:|---:|---:|",
+        "## Peer comparison\n\nSphere, {}², one lookup per pixel (aa 1), {} samples, one thread; {} lookups per render, {} pixels in the 3 × 3-eroded mask. Error of the exitance over the mask against the exhaustive sum on the same samples: relRMSE = RMSE / mean, and the mean relative error. CPU per lookup: the clock time of the translucent points, median over {} interleaved rounds; *process CPU* is the whole render's user + system time per lookup (floor pixels and set-up included, 10 ms ticks), a bound that time spent waiting for a core does not inflate.\n\n| ε | relRMSE | mean rel. | evaluations / lookup | of which aggregates | nodes / lookup | CPU µs / lookup | process CPU µs / lookup |\n|---:|---:|---:|---:|---:|---:|---:|---:|",
         c.resolution, report.samples, report.lookups, report.pixels, c.rounds,
     );
     for r in &report.rows {
         let _ = writeln!(
             s,
-            "| {} | {:.3}% | {:.3}% | {:.1} | {:.1} | {:.3} | {:.3} |",
+            "| {} | {:.3}% | {:.3}% | {:.1} | {:.1} | {:.1} | {:.3} | {:.3} |",
             if r.epsilon >= 1e6 {
                 "∞".to_string()
             } else {
@@ -508,6 +512,7 @@ pub fn markdown(report: &PeerReport) -> String {
             r.rel_rmse * 100.0,
             r.mean_relative * 100.0,
             r.evaluations,
+            r.aggregates,
             r.nodes,
             r.cpu_us,
             r.process_cpu_us
@@ -573,15 +578,16 @@ pub fn markdown(report: &PeerReport) -> String {
 /// `peer.csv`: one row per ε of lucent's curve.
 pub fn csv(report: &PeerReport) -> String {
     let mut s = String::from(
-        "epsilon,rel_rmse,mean_relative,evaluations_per_lookup,nodes_per_lookup,cpu_us_per_lookup,process_cpu_us_per_lookup\n",
+        "epsilon,rel_rmse,mean_relative,evaluations_per_lookup,aggregates_per_lookup,nodes_per_lookup,cpu_us_per_lookup,process_cpu_us_per_lookup\n",
     );
     for r in &report.rows {
         s.push_str(&format!(
-            "{},{:.6e},{:.6e},{:.2},{:.2},{:.4},{:.4}\n",
+            "{},{:.6e},{:.6e},{:.2},{:.2},{:.2},{:.4},{:.4}\n",
             r.epsilon,
             r.rel_rmse,
             r.mean_relative,
             r.evaluations,
+            r.aggregates,
             r.nodes,
             r.cpu_us,
             r.process_cpu_us
@@ -684,6 +690,16 @@ mod tests {
                 .rows
                 .iter()
                 .all(|r| r.cpu_us > 0.0 && r.evaluations > 0.0)
+        );
+        // Coarser ε aggregates more: a larger share of the evaluations are aggregates.
+        let share: Vec<f64> = report
+            .rows
+            .iter()
+            .map(|r| r.aggregates / r.evaluations)
+            .collect();
+        assert!(
+            share.iter().all(|s| (0.0..=1.0).contains(s)) && share[0] < share[2],
+            "{share:?}"
         );
         assert!(markdown(&report).contains("pbrt-v2 dipolesubsurface"));
         assert_eq!(
