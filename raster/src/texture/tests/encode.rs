@@ -5,7 +5,7 @@
 use std::io::Cursor;
 
 use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, LayerAttributes, SmallVec, Vec2,
+    AnyChannel, AnyChannels, Blocks, Encoding, FlatSamples, Image, LayerAttributes, SmallVec, Vec2,
     WritableImage,
 };
 
@@ -110,6 +110,31 @@ pub(crate) fn exr_channels(
     height: usize,
     channels: Vec<(&str, FlatSamples)>,
 ) -> Vec<u8> {
+    exr_encoded(width, height, channels, Encoding::FAST_LOSSLESS)
+}
+
+/// An RGB OpenEXR file of 32-bit floats in `tile × tile` tiles, ZIP compressed.
+pub(crate) fn exr_tiled_rgb_f32(width: usize, height: usize, tile: usize) -> Vec<u8> {
+    let channel =
+        |c: usize| FlatSamples::F32((0..width * height).map(|i| (i + c) as f32).collect());
+    let encoding = Encoding {
+        blocks: Blocks::Tiles(Vec2(tile, tile)),
+        ..Encoding::FAST_LOSSLESS
+    };
+    exr_encoded(
+        width,
+        height,
+        vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))],
+        encoding,
+    )
+}
+
+fn exr_encoded(
+    width: usize,
+    height: usize,
+    channels: Vec<(&str, FlatSamples)>,
+    encoding: Encoding,
+) -> Vec<u8> {
     let list: Vec<AnyChannel<FlatSamples>> = channels
         .into_iter()
         .map(|(name, samples)| AnyChannel::new(name, samples))
@@ -117,7 +142,7 @@ pub(crate) fn exr_channels(
     let layer = exr::image::Layer::new(
         Vec2(width, height),
         LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
+        encoding,
         AnyChannels::sort(SmallVec::from_vec(list)),
     );
     let mut out = Vec::new();

@@ -11,8 +11,8 @@ use super::super::{
     srgb_to_linear,
 };
 use super::encode::{
-    bmp_rgb, exr_channels, exr_rgb_f32, hdr_rgbe, jpeg_grey, jpeg_rgb, tga_grey, tga_header,
-    tga_rgb,
+    bmp_rgb, exr_channels, exr_rgb_f32, exr_tiled_rgb_f32, hdr_rgbe, jpeg_grey, jpeg_rgb, tga_grey,
+    tga_header, tga_rgb,
 };
 use super::{encode_png, patch_ihdr_size};
 
@@ -444,4 +444,38 @@ fn oversized_headers_are_rejected_before_decoding() {
     )
     .expect_err("6 texels > 5");
     assert_eq!(e.message, "image is 3 × 2, more than 5 texels");
+}
+
+/// A tile size far beyond the image is refused from the header: the decoder would allocate a
+/// block of that size before finding that the file does not hold it (a 2.5 KB file made it
+/// zero-fill a gigabyte). Tiles that overhang a small image are real files and still load.
+#[test]
+fn exr_tiles_larger_than_the_image_are_refused_before_decoding() {
+    for (size, tile) in [(2, 64), (5, 2), (40, 300)] {
+        let t = ok(
+            &exr_tiled_rgb_f32(size, size, tile),
+            "t.exr",
+            TextureEncoding::Linear,
+        );
+        assert_eq!((t.width, t.height), (size as u32, size as u32));
+        let want: Vec<Vec3> = (0..size * size)
+            .map(|i| Vec3::new(i as f32, (i + 1) as f32, (i + 2) as f32))
+            .collect();
+        assert_eq!(t.texels, want, "{size}² in {tile}² tiles");
+    }
+    let mut exr = exr_tiled_rgb_f32(64, 64, 16);
+    let at = exr
+        .windows(6)
+        .position(|w| w == b"tiles\0")
+        .expect("tiles attribute");
+    // Name, type "tiledesc", size (4 bytes), then x size and y size (u32 each).
+    let y_size = at + 6 + b"tiledesc\0".len() + 4 + 4;
+    exr[y_size..y_size + 4].copy_from_slice(&16_449_600u32.to_le_bytes());
+    let message = err(&exr, "tiles.exr");
+    assert_eq!(
+        message,
+        "texture tiles.exr: OpenEXR part of 64 × 64 pixels declares tiles of 16 × 16449600 \
+         pixels (3158323200 bytes each, more than the 67108864 bytes lucent allows a block of \
+         this part)",
+    );
 }
