@@ -109,7 +109,8 @@ impl FromStr for Method {
 pub struct QuerySettings {
     /// The method.
     pub method: Method,
-    /// JB02's solid-angle threshold ε: a node is aggregated when A/|x − P|² < ε (0 = never).
+    /// JB02's solid-angle threshold ε: a node is aggregated when max(A, 2π tr C)/|x − P|² < ε,
+    /// its area or, where wider, the area of its flux spread (0 = never).
     pub epsilon: f32,
     /// Relative tolerance for skipping negligible subtrees (0 = never): everything skipped
     /// adds up to at most `cull_tolerance ×` the global sum, per channel.

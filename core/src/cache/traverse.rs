@@ -14,7 +14,9 @@
 //!    weight). Without the deferral, N10 cost 26% more than JB02 at ε = 0.4 on a half-lit
 //!    sphere, all of it on the dark side;
 //! 3. **aggregate** (JB02): x outside the bounds, the bounds clear of the α-ball (split modes,
-//!    LM07's refinement rule), and ΔΩ = A/|x − P|² < ε → one term: the flux times the mean of
+//!    LM07's refinement rule), and max(A, 2π tr C)/|x − P|² < ε (JB02's ΔΩ = A/|x − P|²,
+//!    with the node's flux spread standing in for its area where the spread is the wider; see
+//!    [`spread_area`]) → one term: the flux times the mean of
 //!    Rd over the node *to fourth order* in the Taylor expansion about the centroid, from its
 //!    covariance (departure from JB02, which takes Rd at the centroid alone and underestimates
 //!    where Rd is convex; see [`crate::Dipole::rd_lanes_corrected`] for the derivation). The
@@ -248,6 +250,27 @@ impl<const C: usize> Buffer<C> {
         }
         self.len -= LANES;
     }
+}
+
+/// 2π tr C of eight nodes from `first`: the area of the uniform disc whose covariance has the
+/// node's trace, so that the aggregation rule reads max(A, 2π tr C)/|x − P|² < ε.
+///
+/// The fourth-order aggregate is a Taylor expansion about the centroid whose terms are powers
+/// of the moments over r² (q, tr C, |Cv|²/r², tr C² in [`crate::Dipole::rd_lanes_corrected`]),
+/// so what decides whether it has converged is the flux's spread, tr C/r², more than A/r².
+/// For an evenly lit, evenly sampled flat patch the two agree (a disc of area A has
+/// tr C = A/2π) and the rule is JB02's. They part where the flux spreads wider than the area
+/// suggests: a sliver where an octant clips a curved surface, a strip, a node lit only at its
+/// rim. There the area alone aggregates a node whose expansion is still poor at x: isolated
+/// pixels 20× worse than the rest on a scanned mesh at ε 0.5, for 3–5% fewer evaluations
+/// (BENCHMARKS.md, "The aggregation rule"). The spread alone, without the area, almost doubled
+/// the mean relative error.
+#[inline(always)]
+fn spread_area<L: Lanes>(nodes: &super::Nodes, first: usize) -> L {
+    let trace = lanes_at::<L>(&nodes.cov_xx, first)
+        + lanes_at::<L>(&nodes.cov_yy, first)
+        + lanes_at::<L>(&nodes.cov_zz, first);
+    L::splat(2.0 * core::f32::consts::PI) * trace
 }
 
 struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
@@ -568,7 +591,8 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
 
             let area = lanes_at::<L>(&nodes.area, first);
             let outside = radius.lt(dist * L::splat(DIST_LOWER));
-            let small = area.lt(eps * dist2);
+            let spread = spread_area::<L>(nodes, first);
+            let small = spread.max(area).lt(eps * dist2);
             let aggregate = live & outside & !near & small;
             if aggregate.any() {
                 self.stats.aggregates(aggregate.0.count_ones());

@@ -304,7 +304,7 @@ pub struct RenderSettings {
     /// The most samples `Auto` may place; `None` = sized to the machine's available memory
     /// (`render::density::default_max_samples`). Explicit counts and spacings ignore it.
     pub max_samples: Option<u32>,
-    /// JB02 solid-angle threshold ε (aggregate a node when A/d² < ε).
+    /// JB02 solid-angle threshold ε (aggregate a node when max(A, 2π tr C)/d² < ε).
     pub epsilon: f32,
     /// Smoothing radius factor k: α = k · √(mean sample area).
     pub smoothing: f32,
