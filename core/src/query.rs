@@ -29,7 +29,8 @@ use crate::stats::{NoStats, StatsSink};
 /// How a query sums the cache.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Method {
-    /// Jensen & Buhler 2002: octree sum with the ΔΩ < ε aggregation rule.
+    /// Jensen & Buhler 2002: octree sum with the ΔΩ < ε aggregation rule (ΔΩ from the node's
+    /// area or, where wider, its flux spread).
     Hierarchical,
     /// Langlands & Mertens 2007: precomputed local term E(x)·K plus the (1 − w) global sum.
     LocalGlobal,
