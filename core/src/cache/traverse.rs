@@ -16,7 +16,7 @@
 //! 3. **aggregate** (JB02): x outside the bounds, the bounds clear of the α-ball (split modes,
 //!    LM07's refinement rule), and max(A, 2π tr C)/|x − P|² < ε (JB02's ΔΩ = A/|x − P|²,
 //!    with the node's flux spread standing in for its area where the spread is the wider; see
-//!    [`spread_area`]) → one term: the flux times the mean of
+//!    [`DISC_AREA_PER_TRACE`]) → one term: the flux times the mean of
 //!    Rd over the node *to fourth order* in the Taylor expansion about the centroid, from its
 //!    covariance (departure from JB02, which takes Rd at the centroid alone and underestimates
 //!    where Rd is convex; see [`crate::Dipole::rd_lanes_corrected`] for the derivation). The
@@ -252,8 +252,8 @@ impl<const C: usize> Buffer<C> {
     }
 }
 
-/// 2π tr C of eight nodes from `first`: the area of the uniform disc whose covariance has the
-/// node's trace, so that the aggregation rule reads max(A, 2π tr C)/|x − P|² < ε.
+/// 2π: times a node's tr C, the area of the uniform disc whose covariance has that trace, so
+/// that the aggregation rule reads max(A, 2π tr C)/|x − P|² < ε.
 ///
 /// The fourth-order aggregate is a Taylor expansion about the centroid whose terms are powers
 /// of the moments over r² (q, tr C, |Cv|²/r², tr C² in [`crate::Dipole::rd_lanes_corrected`]),
@@ -265,13 +265,7 @@ impl<const C: usize> Buffer<C> {
 /// pixels 20× worse than the rest on a scanned mesh at ε 0.5, for 3–5% fewer evaluations
 /// (BENCHMARKS.md, "The aggregation rule"). The spread alone, without the area, almost doubled
 /// the mean relative error.
-#[inline(always)]
-fn spread_area<L: Lanes>(nodes: &super::Nodes, first: usize) -> L {
-    let trace = lanes_at::<L>(&nodes.cov_xx, first)
-        + lanes_at::<L>(&nodes.cov_yy, first)
-        + lanes_at::<L>(&nodes.cov_zz, first);
-    L::splat(2.0 * core::f32::consts::PI) * trace
-}
+const DISC_AREA_PER_TRACE: f32 = 2.0 * core::f32::consts::PI;
 
 struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     cache: &'a IrradianceCache,
@@ -591,18 +585,21 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
 
             let area = lanes_at::<L>(&nodes.area, first);
             let outside = radius.lt(dist * L::splat(DIST_LOWER));
-            let spread = spread_area::<L>(nodes, first);
-            let small = spread.max(area).lt(eps * dist2);
+            // tr C decides the aggregation as well as feeding the aggregate's moments.
+            let (sxx, syy, szz) = (
+                lanes_at::<L>(&nodes.cov_xx, first),
+                lanes_at::<L>(&nodes.cov_yy, first),
+                lanes_at::<L>(&nodes.cov_zz, first),
+            );
+            let trace = sxx + syy + szz;
+            let small = (L::splat(DISC_AREA_PER_TRACE) * trace)
+                .max(area)
+                .lt(eps * dist2);
             let aggregate = live & outside & !near & small;
             if aggregate.any() {
                 self.stats.aggregates(aggregate.0.count_ones());
                 // The moments of the fourth-order aggregate (v = P − x): vᵀCv, |Cv|², tr C
                 // and tr C².
-                let (sxx, syy, szz) = (
-                    lanes_at::<L>(&nodes.cov_xx, first),
-                    lanes_at::<L>(&nodes.cov_yy, first),
-                    lanes_at::<L>(&nodes.cov_zz, first),
-                );
                 let (sxy, sxz, syz) = (
                     lanes_at::<L>(&nodes.cov_xy, first),
                     lanes_at::<L>(&nodes.cov_xz, first),
@@ -613,7 +610,6 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                 let cvz = sxz * cx + syz * cy + szz * cz;
                 let vcv = cx * cvx + cy * cvy + cz * cvz;
                 let cv2 = cvx * cvx + cvy * cvy + cvz * cvz;
-                let trace = sxx + syy + szz;
                 let trace_sq = sxx * sxx
                     + syy * syy
                     + szz * szz

@@ -52,14 +52,16 @@ fn check_block_size(header: &exr::meta::header::Header, path: &Path) -> Result<(
         }
     };
     let block_bytes = block_pixels.saturating_mul(bytes_per_pixel);
-    let part_bytes = w.saturating_mul(h).saturating_mul(bytes_per_pixel);
-    if block_bytes > part_bytes.max(BLOCK_BYTES_FLOOR) {
+    let allowed = w
+        .saturating_mul(h)
+        .saturating_mul(bytes_per_pixel)
+        .max(BLOCK_BYTES_FLOOR);
+    if block_bytes > allowed {
         return Err(TextureError::new(
             path,
             format!(
                 "OpenEXR part of {w} × {h} pixels declares {what} ({block_bytes} bytes each, \
-                 more than the {} bytes lucent allows a block of this part)",
-                part_bytes.max(BLOCK_BYTES_FLOOR)
+                 more than the {allowed} bytes lucent allows a block of this part)"
             ),
         ));
     }
