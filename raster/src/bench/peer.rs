@@ -393,7 +393,7 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
         ));
     }
     let scaling = scaling(config, &base, &samples, log)?;
-    let clock_us = clock_pair_us(5, 200_000);
+    let clock_us = clock_pair_us(CLOCK_ROUNDS, CLOCK_PAIRS);
     log(&format!(
         "peer: the clock readings around a point: {:.1} ns per lookup",
         clock_us * 1e3
@@ -408,6 +408,10 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
         clock_us,
     })
 }
+
+/// Loops and reading pairs per loop of the clock measurement ([`clock_pair_us`]).
+const CLOCK_ROUNDS: usize = 5;
+const CLOCK_PAIRS: u32 = 200_000;
 
 /// The time of the in-point clock itself: a reading before a point and the elapsed time after
 /// it, as [`crate::render::ShadingStats`] takes them, with nothing in between; median over
@@ -565,7 +569,7 @@ pub fn markdown(report: &PeerReport) -> String {
     }
     let _ = writeln!(
         s,
-        "\nCPU per lookup at equal relRMSE (log–log interpolation of each curve; *extrapolated* where the level lies outside a curve's range). lucent's time includes the two clock readings around each point, {:.1} ns per lookup on this host (measured in a loop, median of 5 × 200 000 pairs); the last column leaves them out.\n\n| relRMSE | lucent µs | pbrt-v2 µs | ratio | ratio without the clock readings |\n|---:|---:|---:|---:|---:|",
+        "\nCPU per lookup at equal relRMSE (log–log interpolation of each curve; *extrapolated* where the level lies outside a curve's range). lucent's time includes the two clock readings around each point, {:.1} ns per lookup on this host (measured in a loop, median of {CLOCK_ROUNDS} × {CLOCK_PAIRS} pairs); the last column leaves them out.\n\n| relRMSE | lucent µs | pbrt-v2 µs | ratio | ratio without the clock readings |\n|---:|---:|---:|---:|---:|",
         report.clock_us * 1e3
     );
     let cell = |v: Option<(f64, bool)>, digits: usize| match v {
@@ -577,7 +581,11 @@ pub fn markdown(report: &PeerReport) -> String {
         let (ratio, without_clock) = match (ours, theirs) {
             (Some((a, _)), Some((b, _))) => (
                 format!("**{:.1}×**", b / a),
-                format!("{:.1}×", b / (a - report.clock_us)),
+                if a > report.clock_us {
+                    format!("{:.1}×", b / (a - report.clock_us))
+                } else {
+                    "–".to_string()
+                },
             ),
             _ => ("–".to_string(), "–".to_string()),
         };

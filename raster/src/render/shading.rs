@@ -192,8 +192,9 @@ impl Default for PixelValue {
 ///
 /// The time is what the benchmark's "CPU per lookup" divides: a lookup is the whole translucent
 /// point (surface attributes, material, E(x) where the method needs it, the cache query, the
-/// radiance), and the opaque pixels of the same image are not charged to it. Two clock
-/// readings (about 20 ns each with the TSC clock source) are included in the time.
+/// radiance), and the opaque pixels of the same image are not charged to it. The two clock
+/// readings are included in the time: about 20 ns each with the TSC clock source, several
+/// times that on some virtual machines (`lucent bench --peer` measures them).
 pub trait ShadingStats: StatsSink {
     /// Whether translucent points are timed.
     const TIMED: bool;
