@@ -415,10 +415,9 @@ const CLOCK_PAIRS: u32 = 200_000;
 
 /// The time of the in-point clock itself: a reading before a point and the elapsed time after
 /// it, as [`crate::render::ShadingStats`] takes them, with nothing in between; median over
-/// `rounds` loops of `pairs` pairs, µs per pair. What the system's clock source costs varies
-/// by host (about 20 ns per reading with the TSC, several times that where a virtual machine
-/// traps it), so the bench measures it rather than assume it.
-pub fn clock_pair_us(rounds: usize, pairs: u32) -> f64 {
+/// `rounds` loops of `pairs` pairs, µs per pair. Measured rather than assumed, since the clock
+/// source's cost varies by host (see `ShadingStats`).
+fn clock_pair_us(rounds: usize, pairs: u32) -> f64 {
     let per_round: Vec<Duration> = (0..rounds.max(1))
         .map(|_| {
             let mut total = Duration::ZERO;
