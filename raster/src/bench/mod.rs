@@ -56,7 +56,9 @@ use std::time::{Duration, Instant};
 
 pub use charts::{ChartPoint, chart_files, replot, write_charts};
 pub use overhead::{OverheadRow, Spread};
-pub use peer::{PBRT_V2, PEER_LEVELS, PeerConfig, PeerPoint, PeerReport, PeerRow};
+pub use peer::{
+    PBRT_V2, PEER_LEVELS, PeerConfig, PeerInterpolation, PeerPoint, PeerReport, PeerRow,
+};
 pub use profiles::{
     CheckRow, MODELS, ModelCurve, ModelEntry, ModelInput, ProfilesConfig, ProfilesReport,
     WalkResult,

@@ -20,6 +20,10 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use lucent_core::Method;
 
+mod tables;
+
+pub use tables::{csv, markdown};
+
 use super::BenchError;
 use super::runner::median;
 use super::scenes::BenchScene;
@@ -98,6 +102,11 @@ pub struct PeerConfig {
     pub rounds: usize,
     /// Sample placement seed.
     pub seed: u64,
+    /// Curves with exitance interpolation (`render.interpolation`), each at every ε of
+    /// `interpolated_epsilons`: a point is a pixel, queried or blended.
+    pub interpolations: Vec<PeerInterpolation>,
+    /// ε values of the interpolated curves.
+    pub interpolated_epsilons: Vec<f32>,
     /// ε of the one- against two-thread measurement.
     pub scaling_epsilon: f32,
     /// Interleaved rounds of it (0: skip).
@@ -115,6 +124,17 @@ impl PeerConfig {
             ],
             rounds: 5,
             seed: 1,
+            interpolations: vec![
+                PeerInterpolation {
+                    step: 4,
+                    tolerance: 0.25,
+                },
+                PeerInterpolation {
+                    step: 4,
+                    tolerance: 1e9,
+                },
+            ],
+            interpolated_epsilons: vec![0.5, 0.75, 1.0, 1.5, 3.0, 1e9],
             scaling_epsilon: 0.35,
             scaling_rounds: 7,
         }
@@ -128,15 +148,36 @@ impl PeerConfig {
             epsilons: vec![0.25, 1.0, 4.0],
             rounds: 1,
             seed: 1,
+            interpolations: vec![PeerInterpolation {
+                step: 2,
+                tolerance: 1e9,
+            }],
+            interpolated_epsilons: vec![1.0],
             scaling_epsilon: 1.0,
             scaling_rounds: 1,
         }
     }
 }
 
-/// One ε of lucent's curve.
+/// Exitance interpolation of one of lucent's curves (`render.interpolation` and
+/// `render.interpolation_tolerance`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PeerInterpolation {
+    /// Grid spacing, pixels.
+    pub step: u32,
+    /// How alike a block's corners must be.
+    pub tolerance: f32,
+}
+
+/// One ε of one of lucent's curves. A *lookup* is a translucent shading point (one per pixel):
+/// with interpolation, queried or blended, and its CPU time the grid's queries and the blends
+/// together.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PeerRow {
+    /// The curve's interpolation (`None`: every point queried).
+    pub interpolation: Option<PeerInterpolation>,
+    /// The share of the points whose exitance was queried (1 without interpolation).
+    pub queried: f64,
     /// ε.
     pub epsilon: f32,
     /// RMSE / mean of the exitance over the mask, against the exhaustive sum.
@@ -295,8 +336,29 @@ fn exitance(r: &Render) -> Vec<Vec3> {
 
 /// Runs the comparison; `log` receives a line per ε.
 pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport, BenchError> {
-    if config.epsilons.iter().any(|e| !(e.is_finite() && *e > 0.0)) {
+    let series: Vec<(Option<PeerInterpolation>, f32)> = config
+        .epsilons
+        .iter()
+        .map(|&e| (None, e))
+        .chain(config.interpolations.iter().flat_map(|&i| {
+            config
+                .interpolated_epsilons
+                .iter()
+                .map(move |&e| (Some(i), e))
+        }))
+        .collect();
+    if series.iter().any(|(_, e)| !(e.is_finite() && *e > 0.0)) {
         return Err(BenchError::new("every ε must be finite and > 0"));
+    }
+    if config.interpolations.iter().any(|i| {
+        !((2..=crate::scene::MAX_INTERPOLATION_STEP).contains(&i.step)
+            && i.tolerance.is_finite()
+            && i.tolerance >= 0.0)
+    }) {
+        return Err(BenchError::new(format!(
+            "an interpolation needs a step in 2..={} and a finite tolerance ≥ 0",
+            crate::scene::MAX_INTERPOLATION_STEP
+        )));
     }
     if config.rounds == 0 {
         return Err(BenchError::new(
@@ -326,34 +388,45 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
             "the peer comparison's mask is empty (resolution too small?)",
         ));
     }
-    // Rounds interleave the ε values, so that a change of the host's load spreads over all.
-    let mut times: Vec<Vec<Duration>> = vec![Vec::new(); config.epsilons.len()];
-    let mut process: Vec<Vec<Duration>> = vec![Vec::new(); config.epsilons.len()];
-    let mut rows: Vec<Option<PeerRow>> = vec![None; config.epsilons.len()];
+    // Rounds interleave the curves' points, so that a change of the host's load spreads over
+    // all.
+    let mut times: Vec<Vec<Duration>> = vec![Vec::new(); series.len()];
+    let mut process: Vec<Vec<Duration>> = vec![Vec::new(); series.len()];
+    let mut rows: Vec<Option<PeerRow>> = vec![None; series.len()];
     let mut lookups = 0;
     for _ in 0..config.rounds {
-        for (i, &epsilon) in config.epsilons.iter().enumerate() {
+        for (i, &(interpolation, epsilon)) in series.iter().enumerate() {
+            let mut scene = with_method(&base, Method::Hierarchical, epsilon, Some(1));
+            if let Some(i) = interpolation {
+                scene.render.interpolation = i.step;
+                scene.render.interpolation_tolerance = i.tolerance;
+            }
             let before = process_cpu();
-            let r = render(
-                &with_method(&base, Method::Hierarchical, epsilon, Some(1)),
-                &options(&samples),
-            )?;
+            let r = render(&scene, &options(&samples))?;
             if let (Some(a), Some(b)) = (before, process_cpu()) {
                 process[i].push(b.saturating_sub(a));
             }
-            lookups = r.stats.queries;
+            // Per point of the image, for every curve: the per-point curves (first in every
+            // round) count them. With interpolation, queries + blends is a little more: a grid
+            // row between two bands is queried twice, and charged to the points.
+            if interpolation.is_none() || lookups == 0 {
+                lookups = r.stats.queries + r.stats.interpolated;
+            }
+            let points = lookups;
             times[i].push(r.stats.translucent_time.unwrap_or_default());
             if rows[i].is_none() {
                 let (rel_rmse, mean_relative) = relative_errors(&exitance(&r), &reference, &mask);
                 let t = r.stats.traversal.unwrap_or_default();
                 let per_query = |n: u64| {
-                    if t.queries == 0 {
+                    if points == 0 {
                         0.0
                     } else {
-                        n as f64 / t.queries as f64
+                        n as f64 / points as f64
                     }
                 };
                 rows[i] = Some(PeerRow {
+                    interpolation,
+                    queried: per_query(r.stats.queries),
                     epsilon,
                     rel_rmse,
                     mean_relative,
@@ -380,8 +453,17 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
         })
         .collect();
     for r in &rows {
+        let curve = match r.interpolation {
+            Some(i) => format!(
+                "every {} pixels (tolerance {}), {:.0}% queried, ",
+                i.step,
+                i.tolerance,
+                r.queried * 100.0
+            ),
+            None => String::new(),
+        };
         log(&format!(
-            "peer: hierarchical ε {:<6} relRMSE {:.3}%, mean rel. {:.3}%, {:.1} evaluations ({:.1} aggregates), {:.1} nodes, {:.3} µs/lookup ({:.3} process CPU)",
+            "peer: hierarchical {curve}ε {:<6} relRMSE {:.3}%, mean rel. {:.3}%, {:.1} evaluations ({:.1} aggregates), {:.1} nodes, {:.3} µs/lookup ({:.3} process CPU)",
             r.epsilon,
             r.rel_rmse * 100.0,
             r.mean_relative * 100.0,
@@ -410,8 +492,8 @@ pub fn run(config: &PeerConfig, log: &mut dyn FnMut(&str)) -> Result<PeerReport,
 }
 
 /// Loops and reading pairs per loop of the clock measurement ([`clock_pair_us`]).
-const CLOCK_ROUNDS: usize = 5;
-const CLOCK_PAIRS: u32 = 200_000;
+pub(super) const CLOCK_ROUNDS: usize = 5;
+pub(super) const CLOCK_PAIRS: u32 = 200_000;
 
 /// The time of the in-point clock itself: a reading before a point and the elapsed time after
 /// it, as [`crate::render::ShadingStats`] takes them, with nothing in between; median over
@@ -513,128 +595,23 @@ fn scaling(
 /// A curve read at one level: CPU per lookup (µs) and whether it was extrapolated.
 pub type Reading = Option<(f64, bool)>;
 
-/// At each of [`PEER_LEVELS`]: the level, lucent's and the peer's CPU per lookup.
-pub fn ratios(report: &PeerReport) -> Vec<(f64, Reading, Reading)> {
-    let ours: Vec<(f64, f64)> = report.rows.iter().map(|r| (r.rel_rmse, r.cpu_us)).collect();
+/// At each of [`PEER_LEVELS`]: the level, lucent's and the peer's CPU per lookup, lucent's on
+/// the curve of `interpolation` (`None`: every point queried).
+pub fn ratios(
+    report: &PeerReport,
+    interpolation: Option<PeerInterpolation>,
+) -> Vec<(f64, Reading, Reading)> {
+    let ours: Vec<(f64, f64)> = report
+        .rows
+        .iter()
+        .filter(|r| r.interpolation == interpolation)
+        .map(|r| (r.rel_rmse, r.cpu_us))
+        .collect();
     let theirs: Vec<(f64, f64)> = PBRT_V2.iter().map(|p| (p.rel_rmse, p.cpu_us)).collect();
     PEER_LEVELS
         .iter()
         .map(|&level| (level, cpu_at(&ours, level), cpu_at(&theirs, level)))
         .collect()
-}
-
-/// The Markdown section (`## Peer comparison` and its tables).
-pub fn markdown(report: &PeerReport) -> String {
-    use std::fmt::Write as _;
-    let c = &report.config;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "## Peer comparison\n\nSphere, {}², one lookup per pixel (aa 1), {} samples, one thread; {} lookups per render, {} pixels in the 3 × 3-eroded mask. Error of the exitance over the mask against the exhaustive sum on the same samples: relRMSE = RMSE / mean, and the mean relative error. CPU per lookup: the clock time of the translucent points, median over {} interleaved rounds; *process CPU* is the whole render's user + system time per lookup (floor pixels and set-up included, 10 ms ticks), a bound that time spent waiting for a core does not inflate.\n\n| ε | relRMSE | mean rel. | evaluations / lookup | of which aggregates | nodes / lookup | CPU µs / lookup | process CPU µs / lookup |\n|---:|---:|---:|---:|---:|---:|---:|---:|",
-        c.resolution, report.samples, report.lookups, report.pixels, c.rounds,
-    );
-    for r in &report.rows {
-        let _ = writeln!(
-            s,
-            "| {} | {:.3}% | {:.3}% | {:.1} | {:.1} | {:.1} | {:.3} | {:.3} |",
-            if r.epsilon >= 1e6 {
-                "∞".to_string()
-            } else {
-                r.epsilon.to_string()
-            },
-            r.rel_rmse * 100.0,
-            r.mean_relative * 100.0,
-            r.evaluations,
-            r.aggregates,
-            r.nodes,
-            r.cpu_us,
-            r.process_cpu_us
-        );
-    }
-    let _ = writeln!(
-        s,
-        "\npbrt-v2 dipolesubsurface, measured externally on this machine kind (one thread, the same points):\n\n| ε | relRMSE | mean rel. | Rd evaluations / lookup | CPU µs / lookup |\n|---:|---:|---:|---:|---:|"
-    );
-    for p in &PBRT_V2 {
-        let _ = writeln!(
-            s,
-            "| {} | {:.3}% | {:.3}% | {:.0} | {:.1} |",
-            p.epsilon,
-            p.rel_rmse * 100.0,
-            p.mean_relative * 100.0,
-            p.evaluations,
-            p.cpu_us
-        );
-    }
-    let _ = writeln!(
-        s,
-        "\nCPU per lookup at equal relRMSE (log–log interpolation of each curve; *extrapolated* where the level lies outside a curve's range). lucent's time includes the two clock readings around each point, {:.1} ns per lookup on this host (measured in a loop, median of {CLOCK_ROUNDS} × {CLOCK_PAIRS} pairs); the last column leaves them out.\n\n| relRMSE | lucent µs | pbrt-v2 µs | ratio | ratio without the clock readings |\n|---:|---:|---:|---:|---:|",
-        report.clock_us * 1e3
-    );
-    let cell = |v: Option<(f64, bool)>, digits: usize| match v {
-        Some((t, false)) => format!("{t:.digits$}"),
-        Some((t, true)) => format!("{t:.digits$} (extrapolated)"),
-        None => "–".to_string(),
-    };
-    for (level, ours, theirs) in ratios(report) {
-        let (ratio, without_clock) = match (ours, theirs) {
-            (Some((a, _)), Some((b, _))) => (
-                format!("**{:.1}×**", b / a),
-                if a > report.clock_us {
-                    format!("{:.1}×", b / (a - report.clock_us))
-                } else {
-                    "–".to_string()
-                },
-            ),
-            _ => ("–".to_string(), "–".to_string()),
-        };
-        let _ = writeln!(
-            s,
-            "| {}% | {} | {} | {ratio} | {without_clock} |",
-            level * 100.0,
-            cell(ours, 3),
-            cell(theirs, 1)
-        );
-    }
-    if let [one, two] = &report.scaling[..] {
-        let _ = writeln!(
-            s,
-            "\nOne against two threads, hierarchical ε {}, {} interleaved rounds (medians). *In-point* is the clock time around each lookup summed over threads (the CPU per lookup above); *process CPU* is the user + system time of the whole render (10 ms ticks), which a thread waiting for a core does not accrue.\n\n| threads | in-point µs / lookup | process CPU s / render | shading wall s |\n|---:|---:|---:|---:|\n| 1 | {:.3} | {:.3} | {:.3} |\n| 2 | {:.3} | {:.3} | {:.3} |\n| 2 / 1 | {:.2}× | {:.2}× | {:.2}× |",
-            c.scaling_epsilon,
-            c.scaling_rounds,
-            one.cpu_us,
-            one.process_cpu_s,
-            one.shading_wall_s,
-            two.cpu_us,
-            two.process_cpu_s,
-            two.shading_wall_s,
-            two.cpu_us / one.cpu_us,
-            two.process_cpu_s / one.process_cpu_s,
-            two.shading_wall_s / one.shading_wall_s,
-        );
-    }
-    s
-}
-
-/// `peer.csv`: one row per ε of lucent's curve.
-pub fn csv(report: &PeerReport) -> String {
-    let mut s = String::from(
-        "epsilon,rel_rmse,mean_relative,evaluations_per_lookup,aggregates_per_lookup,nodes_per_lookup,cpu_us_per_lookup,process_cpu_us_per_lookup\n",
-    );
-    for r in &report.rows {
-        s.push_str(&format!(
-            "{},{:.6e},{:.6e},{:.2},{:.2},{:.2},{:.4},{:.4}\n",
-            r.epsilon,
-            r.rel_rmse,
-            r.mean_relative,
-            r.evaluations,
-            r.aggregates,
-            r.nodes,
-            r.cpu_us,
-            r.process_cpu_us
-        ));
-    }
-    s
 }
 
 #[cfg(test)]
@@ -722,9 +699,24 @@ mod tests {
     #[test]
     fn the_quick_comparison_orders_its_errors_by_epsilon() {
         let report = run(&PeerConfig::quick(), &mut |_| {}).unwrap();
-        assert_eq!(report.rows.len(), 3);
+        assert_eq!(report.rows.len(), 4);
         assert!(report.pixels > 100 && report.lookups as usize > report.pixels);
-        let errors: Vec<f64> = report.rows.iter().map(|r| r.rel_rmse).collect();
+        // The interpolated curve's point: a share of the pixels queried, a lookup cheaper
+        // than a query at the same ε.
+        let [per_point @ .., blended] = &report.rows[..] else {
+            unreachable!()
+        };
+        assert_eq!(blended.interpolation.map(|i| i.step), Some(2));
+        assert!(per_point.iter().all(|r| r.queried == 1.0));
+        assert!(
+            blended.queried > 0.2 && blended.queried < 0.6,
+            "{}",
+            blended.queried
+        );
+        assert!(blended.evaluations < 0.6 * per_point[1].evaluations);
+        assert!(markdown(&report).contains("With exitance interpolation (`interpolation = 2`"));
+        assert_eq!(csv(&report).lines().count(), 5);
+        let errors: Vec<f64> = per_point.iter().map(|r| r.rel_rmse).collect();
         assert!(errors[0] < errors[1] && errors[1] < errors[2], "{errors:?}");
         assert!(
             report
@@ -757,6 +749,9 @@ mod tests {
         assert!(markdown(&report).contains("ratio without the clock readings"));
         let mut bad = PeerConfig::quick();
         bad.epsilons = vec![0.0];
+        assert!(run(&bad, &mut |_| {}).is_err());
+        let mut bad = PeerConfig::quick();
+        bad.interpolations[0].step = 1;
         assert!(run(&bad, &mut |_| {}).is_err());
     }
 }

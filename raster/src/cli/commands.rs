@@ -13,8 +13,8 @@ use crate::bench::{self, BenchConfig, BenchScene};
 use crate::output::{Placement, Region, refuse_read_only, write_exr, write_exr_tile, write_png};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
-    MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene, default_scene,
-    load_scene,
+    MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene,
+    default_scene, load_scene,
 };
 
 /// Loads the scene named on the command line, or the built-in default, printing its
@@ -145,6 +145,24 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
             "a finite number ≥ 0",
         )?;
         scene.render.epsilon = e;
+    }
+    if let Some(n) = args.interpolation {
+        check(
+            (1..=MAX_INTERPOLATION_STEP).contains(&n),
+            "--interpolation",
+            n,
+            &format!("between 1 and {MAX_INTERPOLATION_STEP}"),
+        )?;
+        scene.render.interpolation = n;
+    }
+    if let Some(t) = args.interpolation_tolerance {
+        check(
+            t.is_finite() && t >= 0.0,
+            "--interpolation-tolerance",
+            t,
+            "a finite number ≥ 0",
+        )?;
+        scene.render.interpolation_tolerance = t;
     }
     if let Some(k) = args.smoothing {
         check(
@@ -288,8 +306,16 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         let crop = args.crop.map_or(String::new(), |r| {
             format!(", crop {r} ({}×{})", r.width(), r.height())
         });
+        let interpolated = if scene.render.interpolation > 1 {
+            format!(
+                ", {} interpolated (every {} pixels)",
+                s.interpolated, scene.render.interpolation
+            )
+        } else {
+            String::new()
+        };
         outln!(
-            "lucent: {}×{}{crop}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads, simd {} → {}",
+            "lucent: {}×{}{crop}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries{interpolated}, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads, simd {} → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,

@@ -130,6 +130,15 @@ pub struct RenderArgs {
     /// JB02 solid-angle threshold ε (smaller = more accurate, slower).
     #[arg(long)]
     pub epsilon: Option<f32>,
+    /// Exitance interpolation: query the subsurface exitance only at every N-th pixel in x and
+    /// y and interpolate between them where the four corners of a block are alike (1–16; 1,
+    /// the default, queries every pixel).
+    #[arg(long, value_name = "N")]
+    pub interpolation: Option<u32>,
+    /// How alike the corners must be: per channel, the largest exitance at most 1 + T times
+    /// the smallest (default 0.25).
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub interpolation_tolerance: Option<f32>,
     /// Smoothing radius factor k of the split methods (α = k·√(mean sample area)).
     #[arg(long, value_name = "K")]
     pub smoothing: Option<f32>,

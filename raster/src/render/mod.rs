@@ -22,6 +22,7 @@ mod convexity;
 pub mod density;
 mod edge_refined;
 mod error;
+mod interpolation;
 mod irradiance;
 mod prepare;
 mod shading;
@@ -32,7 +33,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lucent_core::stats::{NoStats, QueryStats};
+use lucent_core::stats::{NoStats, QueryStats, StatsSink};
 use lucent_core::{IrradianceCache, QuerySettings};
 use rayon::prelude::*;
 
@@ -44,7 +45,8 @@ pub use error::RenderError;
 pub use irradiance::ObjectSamples;
 pub use prepare::{Prepared, can_occlude};
 pub use shading::{
-    ObjectCache, PixelScratch, PixelValue, Shading, ShadingCounters, ShadingStats, UniformMaterial,
+    ObjectCache, PixelScratch, PixelValue, PointCounts, Shading, ShadingCounters, ShadingStats,
+    UniformMaterial,
 };
 
 use crate::lights::Lighting;
@@ -53,6 +55,7 @@ use crate::output::image::{LAYER_EXITANCE, LAYER_GLOBAL, LAYER_IRRADIANCE, LAYER
 use crate::output::{Layer, Region, RgbImage};
 use crate::raster::VisibilityBuffer;
 use crate::scene::Scene;
+use interpolation::{BAND_GRID_ROWS, ExitanceGrid, Interpolation};
 
 /// Options beyond the scene's own settings.
 #[derive(Clone, Copy, Debug, Default)]
@@ -118,8 +121,12 @@ pub struct RenderStats {
     /// Points shaded: one per pixel and visible object in the first pass, and every point of
     /// the pixels the second pass shades again ([`RenderStats::refined_pixels`]).
     pub shading_points: u64,
-    /// Translucent shading points (cache queries), both passes.
+    /// Translucent shading points whose exitance was queried from the cache (cache queries),
+    /// both passes, the interpolation grid's included.
     pub queries: u64,
+    /// Translucent shading points whose exitance was blended from the interpolation grid
+    /// (`render.interpolation`), not queried.
+    pub interpolated: u64,
     /// Sub-samples probed to decide where to shade more than once (one shadow ray per light
     /// each).
     pub probes: u64,
@@ -407,59 +414,85 @@ fn render_in_pool(
     let refine = scene.render.aa > 1 && !options.shade_once;
     let shaded = region.grown(u32::from(refine), camera.width, camera.height);
     let b = bar(options.progress, u64::from(shaded.height()), "shading");
+    let interpolation = (settings.interpolation > 1 && !prep.translucent_objects().is_empty())
+        .then_some(Interpolation {
+            step: settings.interpolation,
+            tolerance: settings.interpolation_tolerance,
+        });
+    // With interpolation, the image is shaded in bands of grid rows, each after its grid.
+    let band_rows = match interpolation {
+        Some(i) => i.step * BAND_GRID_ROWS,
+        None => shaded.height(),
+    }
+    .max(1);
+    let row_width = shaded.width().max(1) as usize;
     // Shaded in place, one row per task: a single buffer, touched once (fresh pages cost a
     // fault each; rows gathered into a second buffer doubled that).
     let mut pixels = vec![PixelValue::default(); shaded.pixels() as usize];
-    let rows: Vec<Result<Row, RenderError>> = pixels
-        .par_chunks_mut(shaded.width().max(1) as usize)
-        .zip(shaded.y0..shaded.y1)
-        // One scratch per rayon job, not per row: its buffers and the last triangle's set-up
-        // are reused along the job's rows (the values do not depend on it).
-        .map_init(PixelScratch::default, |scratch, (out, y)| {
-            let mut row = Row::default();
-            for (x, slot) in (shaded.x0..shaded.x1).zip(out.iter_mut()) {
-                *slot = if options.collect_stats {
-                    shading.pixel(x, y, scratch, &mut row.stats)?
-                } else {
-                    shading.pixel(x, y, scratch, &mut NoStats)?
-                };
-                let groups = &scratch.groups.groups;
-                row.points += groups.len() as u64;
-                row.queries += groups
-                    .iter()
-                    .filter(|g| shading.caches[g.fragment.key as usize].is_some())
-                    .count() as u64;
-            }
-            b.inc(1);
-            Ok(row)
-        })
-        .collect();
-    b.finish_and_clear();
     let mut traversal = QueryStats::default();
     let mut translucent_time = Duration::ZERO;
-    let (mut shading_points, mut queries) = (0, 0);
+    let (mut shading_points, mut queries, mut interpolated) = (0, 0, 0);
     let (mut probes, mut probed_pixels, mut refined_pixels) = (0, 0, 0);
-    for row in rows {
-        let row = row?;
-        let counted = row.stats.traversal;
-        traversal.nodes_opened += counted.nodes_opened;
-        traversal.aggregates += counted.aggregates;
-        traversal.samples += counted.samples;
-        traversal.culled += counted.culled;
-        translucent_time += row.stats.translucent_time;
-        shading_points += row.points;
-        queries += row.queries;
+    for (band, y0) in pixels
+        .chunks_mut(band_rows as usize * row_width)
+        .zip((shaded.y0..shaded.y1).step_by(band_rows as usize))
+    {
+        let y1 = (y0 + band_rows).min(shaded.y1);
+        let grid = match interpolation {
+            Some(settings) => {
+                let rows = Region { y0, y1, ..shaded };
+                let (grid, cost) =
+                    ExitanceGrid::build(&shading, settings, rows, options.collect_stats)?;
+                traversal.merge(&cost.stats.traversal);
+                translucent_time += cost.stats.translucent_time;
+                queries += cost.queries;
+                Some(grid)
+            }
+            None => None,
+        };
+        let rows: Vec<Result<Row, RenderError>> = band
+            .par_chunks_mut(row_width)
+            .zip(y0..y1)
+            // One scratch per rayon job, not per row: its buffers and the last triangle's
+            // set-up are reused along the job's rows (the values do not depend on it).
+            .map_init(PixelScratch::default, |scratch, (out, y)| {
+                let mut row = Row::default();
+                let before = scratch.points;
+                for (x, slot) in (shaded.x0..shaded.x1).zip(out.iter_mut()) {
+                    *slot = match (&grid, options.collect_stats) {
+                        (Some(g), true) => {
+                            shading.pixel_interpolated(x, y, g, scratch, &mut row.stats)?
+                        }
+                        (Some(g), false) => {
+                            shading.pixel_interpolated(x, y, g, scratch, &mut NoStats)?
+                        }
+                        (None, true) => shading.pixel(x, y, scratch, &mut row.stats)?,
+                        (None, false) => shading.pixel(x, y, scratch, &mut NoStats)?,
+                    };
+                    row.points += scratch.groups.groups.len() as u64;
+                }
+                row.queries = scratch.points.queried - before.queried;
+                row.interpolated = scratch.points.interpolated - before.interpolated;
+                b.inc(1);
+                Ok(row)
+            })
+            .collect();
+        for row in rows {
+            let row = row?;
+            traversal.merge(&row.stats.traversal);
+            translucent_time += row.stats.translucent_time;
+            shading_points += row.points;
+            queries += row.queries;
+            interpolated += row.interpolated;
+        }
     }
+    b.finish_and_clear();
     // Second pass: where the shading varies within a pixel, more points.
     if refine {
         let t = Instant::now();
         let refined =
             antialias::refine(&shading, &mut pixels, shaded, region, options.collect_stats)?;
-        let counted = refined.stats.traversal;
-        traversal.nodes_opened += counted.nodes_opened;
-        traversal.aggregates += counted.aggregates;
-        traversal.samples += counted.samples;
-        traversal.culled += counted.culled;
+        traversal.merge(&refined.stats.traversal);
         translucent_time += refined.stats.translucent_time;
         shading_points += refined.points;
         queries += refined.queries;
@@ -494,6 +527,7 @@ fn render_in_pool(
             cache_bytes,
             shading_points,
             queries,
+            interpolated,
             probes,
             probed_pixels,
             refined_pixels,
@@ -533,6 +567,7 @@ struct Row {
     stats: ShadingCounters,
     points: u64,
     queries: u64,
+    interpolated: u64,
 }
 
 /// Near and far planes that enclose the scene: far beyond the farthest corner, near as far out

@@ -23,6 +23,7 @@ use super::RenderError;
 use super::adaptive::GroupScratch;
 use super::attributes::{SurfaceAttributes, TriangleSetup};
 use super::edge_refined::{self, RefinePoint};
+use super::interpolation::{Block, ExitanceGrid};
 use super::prepare::Prepared;
 use crate::camera::Camera;
 use crate::lights::{Lighting, ShadowHints};
@@ -260,6 +261,17 @@ pub struct PixelScratch {
     pub(crate) triangle: TriangleSetup,
     /// The last texture-mapped material's point and plan, re-made in place at each point.
     pub(crate) textured: Option<TexturedScratch>,
+    /// Translucent points shaded with this scratch so far, by where their exitance came from.
+    pub points: PointCounts,
+}
+
+/// Translucent shading points by where their exitance came from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PointCounts {
+    /// A cache query.
+    pub queried: u64,
+    /// Blended from the interpolation grid's points.
+    pub interpolated: u64,
 }
 
 /// The read-only state every pixel is shaded from.
@@ -300,7 +312,23 @@ impl Shading<'_> {
         self.visibility
             .resolve(x, y, |t| object_of[t as usize], &mut scratch.fragments);
         scratch.groups.whole(&scratch.fragments);
-        self.shade(x, y, scratch, stats)
+        self.shade_points(x, y, None, scratch, stats)
+    }
+
+    /// [`Shading::pixel`], with the exitance blended from `grid` where it may be.
+    pub(super) fn pixel_interpolated<S: ShadingStats>(
+        &self,
+        x: u32,
+        y: u32,
+        grid: &ExitanceGrid,
+        scratch: &mut PixelScratch,
+        stats: &mut S,
+    ) -> Result<PixelValue, RenderError> {
+        let object_of = &self.prep.object_of;
+        self.visibility
+            .resolve(x, y, |t| object_of[t as usize], &mut scratch.fragments);
+        scratch.groups.whole(&scratch.fragments);
+        self.shade_points(x, y, Some(grid), scratch, stats)
     }
 
     /// Shades pixel (x, y) at the points in `scratch.groups` (from [`Shading::pixel`], or
@@ -312,27 +340,42 @@ impl Shading<'_> {
         scratch: &mut PixelScratch,
         stats: &mut S,
     ) -> Result<PixelValue, RenderError> {
-        let PixelScratch {
-            shadows,
-            groups,
-            triangle,
-            textured,
-            ..
-        } = scratch;
+        self.shade_points(x, y, None, scratch, stats)
+    }
+
+    /// [`Shading::shade`]; with a grid, a point that is a grid pixel's reuses its kept
+    /// result, and one whose block allows it is blended ([`super::interpolation`]).
+    fn shade_points<S: ShadingStats>(
+        &self,
+        x: u32,
+        y: u32,
+        grid: Option<&ExitanceGrid>,
+        scratch: &mut PixelScratch,
+        stats: &mut S,
+    ) -> Result<PixelValue, RenderError> {
         let mut value = PixelValue::default();
         let aa = self.visibility.aa();
         let per_sample = 1.0 / (aa * aa) as f32;
         let forward = (self.camera.target - self.camera.position).normalize();
-        let pixel_index = y as u64 * self.camera.width as u64 + x as u64;
-        for group in &groups.groups {
+        let groups = std::mem::take(&mut scratch.groups.groups);
+        for group in &groups {
             let fragment = &group.fragment;
-            let seed = group.seed(splitmix64(pixel_index * 16 + group.source as u64));
-            let timed = S::TIMED && self.caches[fragment.key as usize].is_some();
-            let start = timed.then(Instant::now);
-            let s = self.surface(fragment, seed, shadows, triangle, textured, stats)?;
-            if let Some(start) = start {
-                stats.translucent_time(start.elapsed());
-            }
+            let seed = group.seed(self.point_seed(x, y, group.source));
+            let translucent = self.caches[fragment.key as usize].is_some();
+            // Only a whole fragment covering the pixel takes part: the grid holds no other.
+            let grid = grid.filter(|_| translucent && group.part == 0 && self.is_full(fragment));
+            let s = match grid.and_then(|g| g.kept(x, y, fragment)) {
+                Some(node) => node.surface,
+                None => {
+                    let block = grid.and_then(|g| g.block(x, y, fragment));
+                    let s = self.timed_surface(fragment, seed, scratch, block.as_ref(), stats)?;
+                    if translucent {
+                        scratch.points.queried += u64::from(!s.interpolated);
+                        scratch.points.interpolated += u64::from(s.interpolated);
+                    }
+                    s
+                }
+            };
             let w = fragment.coverage as f32 * per_sample;
             value.color += s.color * w;
             value.exitance += s.exitance * w;
@@ -344,7 +387,47 @@ impl Shading<'_> {
                 value.depth = (s.position - self.camera.position).dot(forward);
             }
         }
+        scratch.groups.groups = groups;
         Ok(value)
+    }
+
+    /// The seed of the shading point of pixel (x, y)'s fragment `source`, before any split
+    /// ([`super::adaptive::ShadeGroup::seed`]).
+    pub(super) fn point_seed(&self, x: u32, y: u32, source: usize) -> u64 {
+        let pixel_index = y as u64 * self.camera.width as u64 + x as u64;
+        splitmix64(pixel_index * 16 + source as u64)
+    }
+
+    /// True if `fragment` covers its whole pixel.
+    pub(super) fn is_full(&self, fragment: &Fragment) -> bool {
+        let aa = self.visibility.aa();
+        fragment.coverage == aa * aa
+    }
+
+    /// [`Shading::surface`], timed for the statistics when it is translucent.
+    pub(super) fn timed_surface<S: ShadingStats>(
+        &self,
+        fragment: &Fragment,
+        seed: u64,
+        scratch: &mut PixelScratch,
+        block: Option<&Block>,
+        stats: &mut S,
+    ) -> Result<Surface, RenderError> {
+        let timed = S::TIMED && self.caches[fragment.key as usize].is_some();
+        let start = timed.then(Instant::now);
+        let s = self.surface(
+            fragment,
+            seed,
+            &mut scratch.shadows,
+            &mut scratch.triangle,
+            &mut scratch.textured,
+            block,
+            stats,
+        )?;
+        if let Some(start) = start {
+            stats.translucent_time(start.elapsed());
+        }
+        Ok(s)
     }
 
     fn surface<S: ShadingStats>(
@@ -354,6 +437,7 @@ impl Shading<'_> {
         shadows: &mut ShadowHints,
         triangle: &mut TriangleSetup,
         textured: &mut Option<TexturedScratch>,
+        block: Option<&Block>,
         stats: &mut S,
     ) -> Result<Surface, RenderError> {
         let prep = self.prep;
@@ -368,6 +452,7 @@ impl Shading<'_> {
         let cos_out = outgoing_cosine(normal, geometric, view);
         let mut out = Surface {
             position,
+            normal,
             ..Surface::default()
         };
         let lighting = self.lighting.with_occluders(prep.occluders_for(object));
@@ -407,9 +492,13 @@ impl Shading<'_> {
                     }
                 };
                 let method = self.settings.method;
+                let blended = block.and_then(|b| b.blend(position, normal));
                 let mut e = Vec3::ZERO;
                 let mut highlight = Vec3::ZERO;
-                if method.is_split() || shader.specular.is_some() || self.irradiance_everywhere {
+                if (method.is_split() && blended.is_none())
+                    || shader.specular.is_some()
+                    || self.irradiance_everywhere
+                {
                     lighting.for_each(position, normal, seed, shadows, |incident| {
                         e += incident.irradiance;
                         if let Some(spec) = shader.specular {
@@ -425,78 +514,90 @@ impl Shading<'_> {
                         }
                     });
                 }
-                let shading_point = ShadingPoint {
-                    position,
-                    irradiance: e,
-                };
-                let (local, m) = match uniform {
-                    Some(u) => (
-                        u.plan.local(),
-                        super::simd::query_planned(&oc.cache, &u.plan, &shading_point, stats),
-                    ),
+                // The query, unless the exitance is blended from the grid.
+                let m = match blended {
+                    Some(m) => m,
                     None => {
-                        let local = match (&oc.local, oc.uniform_k) {
-                            (Some(_), _) if self.exact_local_integral => {
-                                LocalTerm::exact(&point.profile, oc.alpha).map_err(|e| {
-                                    RenderError::Material(MaterialError::Params {
-                                        material: shader.name.clone(),
-                                        source: e,
-                                    })
-                                })?
-                            }
-                            (Some(_), Some(term)) => term,
-                            (Some(source), None) => source.lookup(point),
-                            (None, _) => LocalTerm::NONE,
+                        let shading_point = ShadingPoint {
+                            position,
+                            irradiance: e,
                         };
-                        let m = match textured_plan {
-                            Some(plan) => oc
-                                .cache
-                                .replan_into(plan, &point.profile, local)
-                                .and_then(|()| {
-                                    super::simd::query_planned(
-                                        &oc.cache,
-                                        plan,
-                                        &shading_point,
-                                        stats,
-                                    )
-                                }),
-                            None => super::simd::query(
-                                &oc.cache,
-                                &point.profile,
-                                &shading_point,
-                                local,
-                                &self.settings,
-                                stats,
+                        let (local, m) = match uniform {
+                            Some(u) => (
+                                u.plan.local(),
+                                super::simd::query_planned(
+                                    &oc.cache,
+                                    &u.plan,
+                                    &shading_point,
+                                    stats,
+                                ),
                             ),
+                            None => {
+                                let local = match (&oc.local, oc.uniform_k) {
+                                    (Some(_), _) if self.exact_local_integral => {
+                                        LocalTerm::exact(&point.profile, oc.alpha).map_err(|e| {
+                                            RenderError::Material(MaterialError::Params {
+                                                material: shader.name.clone(),
+                                                source: e,
+                                            })
+                                        })?
+                                    }
+                                    (Some(_), Some(term)) => term,
+                                    (Some(source), None) => source.lookup(point),
+                                    (None, _) => LocalTerm::NONE,
+                                };
+                                let m = match textured_plan {
+                                    Some(plan) => oc
+                                        .cache
+                                        .replan_into(plan, &point.profile, local)
+                                        .and_then(|()| {
+                                            super::simd::query_planned(
+                                                &oc.cache,
+                                                plan,
+                                                &shading_point,
+                                                stats,
+                                            )
+                                        }),
+                                    None => super::simd::query(
+                                        &oc.cache,
+                                        &point.profile,
+                                        &shading_point,
+                                        local,
+                                        &self.settings,
+                                        stats,
+                                    ),
+                                };
+                                (local, m)
+                            }
                         };
-                        (local, m)
-                    }
-                };
-                let m = m.map_err(|source| RenderError::Query { position, source })?;
-                let m = if m.refine {
-                    let q = match (&oc.quadrature, &oc.quadrature_layout) {
-                        (Some(q), _) => *q,
-                        (None, Some(layout)) => {
-                            LocalQuadrature::with_layout(&point.profile, layout)
+                        let m = m.map_err(|source| RenderError::Query { position, source })?;
+                        if m.refine {
+                            let q = match (&oc.quadrature, &oc.quadrature_layout) {
+                                (Some(q), _) => *q,
+                                (None, Some(layout)) => {
+                                    LocalQuadrature::with_layout(&point.profile, layout)
+                                }
+                                (None, None) => edge_refined::quadrature(&point.profile, oc.alpha),
+                            };
+                            let at = RefinePoint {
+                                position,
+                                normal,
+                                irradiance: e,
+                                local,
+                                seed,
+                            };
+                            edge_refined::refine(&lighting, &q, &at, shadows, m)
+                        } else {
+                            m
                         }
-                        (None, None) => edge_refined::quadrature(&point.profile, oc.alpha),
-                    };
-                    let at = RefinePoint {
-                        position,
-                        normal,
-                        irradiance: e,
-                        local,
-                        seed,
-                    };
-                    edge_refined::refine(&lighting, &q, &at, shadows, m)
-                } else {
-                    m
+                    }
                 };
                 out.exitance = m.total;
                 out.local = m.local;
                 out.global = m.global;
                 out.irradiance = e;
                 out.color = point.profile.radiance(m.total, cos_out) + highlight;
+                out.interpolated = blended.is_some();
             }
         }
         Ok(out)
@@ -516,14 +617,19 @@ fn outgoing_cosine(shading: Vec3, geometric: Vec3, view: Vec3) -> f32 {
     shading.dot(view).max(geometric.dot(view)).clamp(0.0, 1.0)
 }
 
+/// What one shading point contributes.
 #[derive(Clone, Copy, Debug, Default)]
-struct Surface {
-    position: Vec3,
-    color: Vec3,
-    exitance: Vec3,
-    local: Vec3,
-    global: Vec3,
-    irradiance: Vec3,
+pub(super) struct Surface {
+    pub position: Vec3,
+    /// The shading normal (unit, towards the camera).
+    pub normal: Vec3,
+    pub color: Vec3,
+    pub exitance: Vec3,
+    pub local: Vec3,
+    pub global: Vec3,
+    pub irradiance: Vec3,
+    /// The exitance was blended from the grid ([`super::interpolation`]), not queried.
+    pub interpolated: bool,
 }
 
 #[cfg(test)]

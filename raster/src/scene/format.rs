@@ -135,6 +135,8 @@ pub(crate) struct RawRender {
     pub smoothing: Option<Num>,
     pub ell_min: Option<Num>,
     pub cull_tolerance: Option<Num>,
+    pub interpolation: Option<Int>,
+    pub interpolation_tolerance: Option<Num>,
     pub aa: Option<Int>,
     pub exposure: Option<Num>,
     pub threads: Option<Int>,

@@ -294,6 +294,10 @@ impl From<SampleDensity> for SampleRequest {
     }
 }
 
+/// The largest `render.interpolation` step: beyond 16 pixels a block spans more of the
+/// surface than the corners' alikeness test can vouch for.
+pub const MAX_INTERPOLATION_STEP: u32 = 16;
+
 /// Render settings (the `[render]` table).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -313,6 +317,13 @@ pub struct RenderSettings {
     pub ell_min: Option<f32>,
     /// Relative tolerance below which whole subtrees are skipped (0 = never skip).
     pub cull_tolerance: f32,
+    /// Exitance interpolation: query the cache only at every `interpolation`-th pixel in x and
+    /// y, and interpolate between those where they are alike (1 = query every pixel; see
+    /// `raster/src/render/interpolation.rs`).
+    pub interpolation: u32,
+    /// How alike the four corners of an interpolated block must be: per channel, the largest
+    /// exitance at most `1 + interpolation_tolerance` times the smallest.
+    pub interpolation_tolerance: f32,
     /// Anti-aliasing: `aa × aa` sub-samples per pixel for coverage.
     pub aa: u32,
     /// Exposure in stops applied before the PNG's sRGB encoding.
@@ -333,6 +344,8 @@ impl Default for RenderSettings {
             smoothing: 1.5,
             ell_min: None,
             cull_tolerance: 1e-4,
+            interpolation: 1,
+            interpolation_tolerance: 0.25,
             aa: 2,
             exposure: 0.0,
             threads: None,

@@ -9,7 +9,9 @@ use toml::Spanned;
 use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::{RawCamera, RawOutput, RawRender, RawSamples};
-use super::model::{ExrLayers, OutputSettings, RenderSettings, SampleDensity, SampleRequest};
+use super::model::{
+    ExrLayers, MAX_INTERPOLATION_STEP, OutputSettings, RenderSettings, SampleDensity, SampleRequest,
+};
 use crate::camera::Camera;
 
 /// Default image width and height.
@@ -192,6 +194,17 @@ pub(crate) fn build_render(
             |x| (0.0..1.0).contains(&x),
             "must be in [0, 1)",
         )?;
+    }
+    if let Some(v) = &r.interpolation {
+        s.interpolation = c.int(
+            "render.interpolation",
+            v,
+            1,
+            i64::from(MAX_INTERPOLATION_STEP),
+        )? as u32;
+    }
+    if let Some(v) = &r.interpolation_tolerance {
+        s.interpolation_tolerance = c.non_negative("render.interpolation_tolerance", v)?;
     }
     if let Some(v) = &r.aa {
         s.aa = c.int("render.aa", v, 1, 8)? as u32;

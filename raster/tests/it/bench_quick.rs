@@ -185,13 +185,16 @@ fn quick_bench_writes_a_complete_report() {
     ] {
         assert!(report.contains(needle), "report.md lacks '{needle}'");
     }
-    // The peer curve: one row per ε of the quick sweep, errors and times positive.
+    // The peer curves: one row per ε of the quick sweep, then the interpolated curve's one;
+    // step, share queried, ε, errors, evaluations and times positive.
     let peer = std::fs::read_to_string(out.join("peer.csv")).unwrap();
     let peer_rows: Vec<&str> = peer.lines().skip(1).collect();
-    assert_eq!(peer_rows.len(), 3, "{peer}");
-    for row in peer_rows {
+    assert_eq!(peer_rows.len(), 4, "{peer}");
+    for (i, row) in peer_rows.iter().enumerate() {
         let cells: Vec<f64> = row.split(',').map(|c| c.parse().unwrap()).collect();
-        assert!(cells[..6].iter().all(|&v| v > 0.0), "{row}");
+        assert_eq!(cells[0], if i < 3 { 1.0 } else { 2.0 }, "{row}");
+        assert!(cells[2] > 0.0 && cells[2] <= 1.0, "{row}");
+        assert!(cells[3..10].iter().all(|&v| v > 0.0), "{row}");
     }
     let labels = [
         "hierarchical eps=0.5",

@@ -8,6 +8,7 @@
 mod edge_reference;
 mod fuzz_corpus;
 mod golden;
+mod interpolation;
 mod meshes;
 mod render_physics;
 mod shading_aa;

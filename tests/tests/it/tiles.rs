@@ -2,7 +2,8 @@
 //! --crop` does), written as EXR tiles and merged (`lucent merge`), gives the same bytes as a
 //! single render: the PNG, and the EXR with its alpha and every layer. At `aa = 1` and with the
 //! second shading pass (`aa = 3`), whose contrast test reads each pixel's neighbours, so that
-//! the shadow edge crossing the tile borders tests the margin the tiles render.
+//! the shadow edge crossing the tile borders tests the margin the tiles render; and with
+//! exitance interpolation, whose grid crosses the tile borders.
 
 use std::path::{Path, PathBuf};
 
@@ -32,13 +33,21 @@ const TILES: [&str; 13] = [
     "20,22,40,30",
 ];
 
-fn scene(aa: u32) -> Scene {
+fn scene(aa: u32, interpolation: u32) -> Scene {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut scene = load_scene(&root.join("scenes/sphere-shadow.toml")).unwrap();
     scene.camera.width = 40;
     scene.camera.height = 30;
     scene.render.samples = SampleDensity::Count(1500).into();
     scene.render.aa = aa;
+    scene.render.interpolation = interpolation;
+    if interpolation > 1 {
+        // The sphere fills the view (a radius of about 25 pixels), so that blocks of its
+        // surface are flat enough to blend; the shadow edge still runs down the middle. The
+        // wide tolerance blends across the 1500 samples' pixel-to-pixel scatter.
+        scene.camera.vfov_degrees = 10.0;
+        scene.render.interpolation_tolerance = 1.0;
+    }
     scene.render.threads = Some(2);
     scene.render.exposure = 0.75;
     scene.output.layers = ExrLayers {
@@ -80,9 +89,9 @@ fn options(baked: &[ObjectSamples], crop: Option<Region>) -> RenderOptions<'_> {
     }
 }
 
-fn check_tiles_merge_to_the_whole_render(aa: u32) {
-    let dir = Dir::new(&format!("aa{aa}"));
-    let scene = scene(aa);
+fn check_tiles_merge_to_the_whole_render(aa: u32, interpolation: u32) {
+    let dir = Dir::new(&format!("aa{aa}-{interpolation}"));
+    let scene = scene(aa, interpolation);
     let baked = bake(&scene, false).unwrap();
     let whole = render(&scene, &options(&baked, None)).unwrap();
     let layers = whole.layers(&scene.output.layers);
@@ -94,6 +103,13 @@ fn check_tiles_merge_to_the_whole_render(aa: u32) {
         &layers,
     )
     .unwrap();
+    if interpolation > 1 {
+        assert!(
+            whole.stats.interpolated > 200,
+            "every {interpolation} pixels: {} blended, so the tiles would not test it",
+            whole.stats.interpolated
+        );
+    }
     if aa > 1 {
         assert!(
             whole.stats.refined_pixels > 0,
@@ -162,17 +178,29 @@ fn check_tiles_merge_to_the_whole_render(aa: u32) {
 
 #[test]
 fn tiles_merge_to_the_whole_render_at_aa_1() {
-    check_tiles_merge_to_the_whole_render(1);
+    check_tiles_merge_to_the_whole_render(1, 1);
 }
 
 #[test]
 fn tiles_merge_to_the_whole_render_with_the_second_pass() {
-    check_tiles_merge_to_the_whole_render(3);
+    check_tiles_merge_to_the_whole_render(3, 1);
+}
+
+/// The grid of every 4th pixel (the last column and row clamped to the image) crosses the tile
+/// borders: each tile queries the grid pixels around it.
+#[test]
+fn tiles_merge_to_the_whole_render_with_interpolation() {
+    check_tiles_merge_to_the_whole_render(1, 4);
+}
+
+#[test]
+fn tiles_merge_to_the_whole_render_with_interpolation_and_the_second_pass() {
+    check_tiles_merge_to_the_whole_render(3, 3);
 }
 
 #[test]
 fn crops_outside_the_image_are_errors() {
-    let scene = scene(2);
+    let scene = scene(2, 1);
     for text in ["0,0,41,30", "39,29,40,31", "40,0,41,1"] {
         let crop = Region::parse(text).unwrap();
         let e = render(

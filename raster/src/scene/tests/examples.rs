@@ -73,6 +73,8 @@ epsilon = 0.1
 smoothing = 2
 ell_min = 0.001
 cull_tolerance = 0
+interpolation = 3
+interpolation_tolerance = 0.5
 aa = 4
 exposure = -1.5
 threads = 3
@@ -172,6 +174,8 @@ layers = ["local", "depth"]
             smoothing: 2.0,
             ell_min: Some(0.001),
             cull_tolerance: 0.0,
+            interpolation: 3,
+            interpolation_tolerance: 0.5,
             aa: 4,
             exposure: -1.5,
             threads: Some(3),

@@ -257,6 +257,10 @@ fn render_and_output_values() {
         render("max_samples = 40000000") => "max_samples", "render.max_samples", "1..=33554432";
         render("epsilon = -0.1") => "epsilon", "render.epsilon", "at least 0";
         render("cull_tolerance = 1") => "cull_tolerance", "render.cull_tolerance", "[0, 1)";
+        render("interpolation = 0") => "interpolation", "render.interpolation", "1..=16";
+        render("interpolation = 17") => "interpolation", "render.interpolation", "(got 17)";
+        render("interpolation_tolerance = -0.5") => "interpolation_tolerance", "render.interpolation_tolerance", "at least 0";
+        render("interpolation_tolerance = inf") => "interpolation_tolerance", "render.interpolation_tolerance", "finite";
         render("ell_min = 0") => "ell_min", "render.ell_min", "greater than 0";
         render("exposure = 100") => "exposure", "render.exposure", "stops";
         render("threads = 0") => "threads", "render.threads", "1..=";

@@ -53,7 +53,13 @@ fn bad_flags_are_usage_errors() {
 #[test]
 fn nan_and_infinite_flag_values() {
     let sb = Sandbox::new("flags-nan");
-    for flag in ["--epsilon", "--smoothing", "--spacing", "--exposure"] {
+    for flag in [
+        "--epsilon",
+        "--smoothing",
+        "--spacing",
+        "--exposure",
+        "--interpolation-tolerance",
+    ] {
         for (value, shown) in [
             ("NaN", "NaN"),
             ("nan", "NaN"),
@@ -99,6 +105,15 @@ fn zero_and_huge_resolution_flags() {
         (&["--threads", "0"], &["--threads 0"]),
         (&["--spacing", "0"], &["--spacing 0", "positive"]),
         (&["--exposure", "65"], &["--exposure 65"]),
+        (
+            &["--interpolation", "0"],
+            &["--interpolation 0", "between 1 and 16"],
+        ),
+        (&["--interpolation", "17"], &["--interpolation 17"]),
+        (
+            &["--interpolation-tolerance", "-0.5"],
+            &["--interpolation-tolerance -0.5", "≥ 0"],
+        ),
     ];
     for (extra, needles) in cases {
         sb.fails(&render(extra), 1, needles);
