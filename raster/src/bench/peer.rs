@@ -130,6 +130,10 @@ impl PeerConfig {
                     tolerance: 0.25,
                 },
                 PeerInterpolation {
+                    step: 2,
+                    tolerance: 1e9,
+                },
+                PeerInterpolation {
                     step: 4,
                     tolerance: 1e9,
                 },
