@@ -5,7 +5,7 @@
 //! result must also keep the invariants the renderer relies on: every mesh passes
 //! `validate_mesh` (and, checked here independently, its indices are in range and its
 //! positions finite), every object's material exists, the camera gives a finite view, and the
-//! render settings are valid query settings.
+//! render settings are valid query settings (and interpolation settings).
 
 use std::borrow::Cow;
 
@@ -16,7 +16,7 @@ use lucent_raster::scene::mesh::validate_mesh;
 use lucent_raster::scene::mtl::parse_mtl;
 use lucent_raster::scene::obj::load_obj;
 use lucent_raster::scene::weld::weld_normals;
-use lucent_raster::scene::{Light, Mesh, SceneOrigin, parse_scene};
+use lucent_raster::scene::{Light, MAX_INTERPOLATION_STEP, Mesh, SceneOrigin, parse_scene};
 
 /// A small closed mesh (a tetrahedron with UVs and normals) served under the bunny's path, so
 /// that the repository's scenes parse quickly inside the fuzzer.
@@ -137,6 +137,12 @@ pub fn scene_parse_never_panics(data: &[u8]) {
         "render settings {r:?}"
     );
     assert!((1..=MAX_AA).contains(&r.aa), "render settings {r:?}");
+    assert!(
+        (1..=MAX_INTERPOLATION_STEP).contains(&r.interpolation)
+            && r.interpolation_tolerance.is_finite()
+            && r.interpolation_tolerance >= 0.0,
+        "render settings {r:?}"
+    );
     for light in &scene.lights {
         match light {
             Light::Rect {
