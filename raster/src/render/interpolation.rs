@@ -277,33 +277,39 @@ impl ExitanceGrid {
     pub fn block(&self, x: u32, y: u32, fragment: &Fragment) -> Option<Block<'_>> {
         let step = self.settings.step;
         let (i, j) = (Self::index(step, x), Self::index(step, y));
-        let (bi, bj) = (i.checked_sub(self.origin.0)?, j.checked_sub(self.origin.1)?);
+        let (bi, bj) = (i.wrapping_sub(self.origin.0), j.wrapping_sub(self.origin.1));
         if bi >= self.cols || bj >= self.rows {
             return None;
         }
-        if self.blocks[(bj * self.cols + bi) as usize] != Some(fragment.key) {
+        let at = (bj * self.cols + bi) as usize;
+        if self.blocks[at] != Some(fragment.key) {
             return None;
         }
-        let [a, b, c, d] = self.corner_indices(i, j);
+        // The next column and row, or the same ones at the grid's last; held, since the block
+        // was decided alike.
+        let right = i < self.last_index.0;
+        let down = j < self.last_index.1;
+        let di = usize::from(right);
+        let dj = if down { self.cols as usize } else { 0 };
+        let node = |k: usize| self.nodes.get(k)?.as_ref();
         let corners = [
-            self.node_at(a.0, a.1)?,
-            self.node_at(b.0, b.1)?,
-            self.node_at(c.0, c.1)?,
-            self.node_at(d.0, d.1)?,
+            node(at)?,
+            node(at + di)?,
+            node(at + dj)?,
+            node(at + di + dj)?,
         ];
-        let fraction = |p: u32, i0: u32, i1: u32, last: u32| {
-            let (a, b) = (
-                Self::coordinate(step, i0, last),
-                Self::coordinate(step, i1, last),
-            );
-            if b > a {
-                (p - a) as f32 / (b - a) as f32
-            } else {
-                0.0
+        // Where the pixel lies between the corners' columns (or rows): i·step and the next,
+        // clamped to the image's last; 0 on the grid's last.
+        let fraction = |p: u32, i: u32, next: bool, last: u32| {
+            if !next {
+                return 0.0;
             }
+            let a = i * step;
+            let b = (a + step).min(last);
+            (p - a) as f32 / (b - a) as f32
         };
-        let u = fraction(x, a.0, d.0, self.last.0);
-        let v = fraction(y, a.1, d.1, self.last.1);
+        let u = fraction(x, i, right, self.last.0);
+        let v = fraction(y, j, down, self.last.1);
         Some(Block {
             corners,
             weights: [(1.0 - u) * (1.0 - v), u * (1.0 - v), (1.0 - u) * v, u * v],
