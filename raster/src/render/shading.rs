@@ -308,11 +308,16 @@ impl Shading<'_> {
         scratch: &mut PixelScratch,
         stats: &mut S,
     ) -> Result<PixelValue, RenderError> {
+        self.resolve_whole(x, y, scratch);
+        self.shade_points(x, y, None, scratch, stats)
+    }
+
+    /// Pixel (x, y)'s fragments into `scratch`, one unsplit shading point each.
+    fn resolve_whole(&self, x: u32, y: u32, scratch: &mut PixelScratch) {
         let object_of = &self.prep.object_of;
         self.visibility
             .resolve(x, y, |t| object_of[t as usize], &mut scratch.fragments);
         scratch.groups.whole(&scratch.fragments);
-        self.shade_points(x, y, None, scratch, stats)
     }
 
     /// [`Shading::pixel`], with the exitance blended from `grid` where it may be.
@@ -324,10 +329,7 @@ impl Shading<'_> {
         scratch: &mut PixelScratch,
         stats: &mut S,
     ) -> Result<PixelValue, RenderError> {
-        let object_of = &self.prep.object_of;
-        self.visibility
-            .resolve(x, y, |t| object_of[t as usize], &mut scratch.fragments);
-        scratch.groups.whole(&scratch.fragments);
+        self.resolve_whole(x, y, scratch);
         self.shade_points(x, y, Some(grid), scratch, stats)
     }
 

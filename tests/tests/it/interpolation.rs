@@ -14,57 +14,16 @@ use std::path::Path;
 use lucent_core::Method;
 use lucent_core::glam::Vec3;
 use lucent_raster::render::{ObjectSamples, Render, RenderOptions, bake, render};
-use lucent_raster::scene::{SampleDensity, Scene, SceneOrigin, load_scene, parse_scene};
+use lucent_raster::scene::{SampleDensity, Scene, load_scene};
 
-/// K_d of the plane.
-const KD: Vec3 = Vec3::new(0.5, 0.3, 0.15);
+use super::render_physics::{KD, plane_scene};
 
-/// A 40 × 40 plane (K_d = [`KD`], ℓ_u = 0.5) under a directional light delivering E = 2, seen
-/// from straight above, 32² pixels about 5 units across.
+/// The lit plane of `render_physics.rs` (K_d = [`KD`], ℓ_u = 0.5, E = 2, seen from straight
+/// above, about 5 units across) at 32² and 60 000 samples.
 fn plane(method: &str, interpolation: u32) -> Scene {
-    let text = format!(
-        r#"
-[camera]
-position = [0.0, 0.0, 30.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 10.0
-width = 32
-height = 32
-
-[[object]]
-name = "slab"
-shape = "plane"
-size = [40.0, 40.0]
-material = "wax"
-
-[material.wax]
-type = "translucent"
-kd = [{}, {}, {}]
-mean_free_path = 0.5
-eta = 1.4
-
-[[light]]
-type = "directional"
-direction = [0.0, 0.0, -1.0]
-irradiance = 2.0
-
-[render]
-method = "{method}"
-samples = 60000
-aa = 1
-interpolation = {interpolation}
-"#,
-        KD.x, KD.y, KD.z
-    );
-    parse_scene(
-        &text,
-        &SceneOrigin::Embedded {
-            name: "plane.toml".into(),
-            files: Vec::new(),
-        },
-    )
-    .expect("test scene parses")
+    let mut scene = plane_scene(method, false, 32, 60_000);
+    scene.render.interpolation = interpolation;
+    scene
 }
 
 /// The central 12 × 12 pixels of a 32² plane render: mean and worst relative error of the

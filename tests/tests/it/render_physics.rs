@@ -15,13 +15,13 @@ use lucent_raster::scene::{Scene, SceneOrigin, parse_scene};
 
 /// K_d of the test plane (ℓ_d ≤ 1.8 with ℓ_u = 0.5, so the 40 × 40 plane extends 11
 /// diffusion lengths around its centre: the missing tail is e^−11).
-const KD: Vec3 = Vec3::new(0.5, 0.3, 0.15);
+pub(crate) const KD: Vec3 = Vec3::new(0.5, 0.3, 0.15);
 
 /// A 40 × 40 translucent plane at z = 0 (K_d = [`KD`], ℓ_u = 0.5) under a directional light
 /// delivering E = 2, seen from straight above (the view is about 5 units across). With
 /// `occluder`, the light comes in at 45° and an opaque plate at z = 3, outside the view, covers
 /// x < −3: its shadow edge on the plane is the line x = 0.
-fn plane_scene(method: &str, occluder: bool, width: u32, samples: u32) -> Scene {
+pub(crate) fn plane_scene(method: &str, occluder: bool, width: u32, samples: u32) -> Scene {
     let (plate, light) = if occluder {
         (
             r#"
