@@ -219,7 +219,7 @@ pub struct PeerReport {
     /// The same lookups on one and on two threads.
     pub scaling: Vec<ScalingRow>,
     /// What the two clock readings around each translucent point cost on this host, µs per
-    /// lookup (see [`clock_pair_us`]); the CPU per lookup includes them.
+    /// lookup (measured in a loop by `lucent bench --peer`); the CPU per lookup includes them.
     pub clock_us: f64,
 }
 

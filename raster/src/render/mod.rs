@@ -12,7 +12,8 @@
 //! for any thread count. With `aa > 1`, a second pass (`antialias`, `adaptive`) re-shades the
 //! pixels whose sub-samples see different light, normals or material at one point per group of
 //! alike sub-samples; it reads the first pass's image and writes only its own pixels, so it is
-//! deterministic too.
+//! deterministic too. With `interpolation > 1` (`interpolation`), the first pass runs in bands
+//! of rows, each after the grid of pixels whose exitance the band's other pixels blend from.
 
 mod adaptive;
 mod antialias;
