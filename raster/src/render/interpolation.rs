@@ -14,7 +14,9 @@
 //! A point of object O is blended from its block's corners when
 //!
 //! 1. every corner pixel holds one fragment, of O, covering it fully (no silhouette, no other
-//!    object), and so does the point's own pixel;
+//!    object), and so does the point's own pixel; O's material does not vary over its surface
+//!    (with a texture-mapped K_d or mean free path, the exitance follows the texture's detail,
+//!    which the corners do not see, so such objects are queried at every pixel);
 //! 2. the corners are alike: per channel, the largest exitance M_o is at most
 //!    `1 + tolerance` times the smallest (a shadow edge, a lit rim, a texture edge between
 //!    them make them unlike);
@@ -47,6 +49,7 @@ use rayon::prelude::*;
 
 use super::RenderError;
 use super::shading::{PixelScratch, Shading, ShadingCounters, ShadingStats, Surface};
+use crate::material::Shader;
 use crate::output::Region;
 use crate::raster::Fragment;
 
@@ -69,7 +72,7 @@ pub(super) struct Interpolation {
 }
 
 /// A grid pixel's shading point, kept where it can anchor a blend (one fragment covering the
-/// pixel, of a translucent object).
+/// pixel, of a translucent object whose material does not vary).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Node {
     /// The pixel's one fragment.
@@ -206,7 +209,12 @@ impl ExitanceGrid {
         let [fragment] = scratch.fragments[..] else {
             return Ok(None);
         };
-        if !shading.is_full(&fragment) || shading.caches[fragment.key as usize].is_none() {
+        let object = fragment.key as usize;
+        let uniform = match shading.prep.shader_of(object) {
+            Shader::Translucent(shader) => !shader.is_textured(),
+            Shader::Lambert { .. } => false,
+        };
+        if !uniform || !shading.is_full(&fragment) || shading.caches[object].is_none() {
             return Ok(None);
         }
         let seed = shading.point_seed(x, y, 0);

@@ -6,6 +6,7 @@
 //! - On the half-shadowed marble sphere (curved, a shadow edge, a silhouette), the error
 //!   against a converged image is no worse than the per-pixel query's.
 //! - The image does not depend on the thread count.
+//! - Texture-mapped materials are not interpolated.
 //!
 //! (That tiles merge to the whole render with interpolation is in `tiles.rs`.)
 
@@ -189,4 +190,24 @@ fn interpolated_images_do_not_depend_on_the_thread_count() {
     );
     assert_eq!(a.stats.queries, b.stats.queries);
     assert_eq!(a.stats.interpolated, b.stats.interpolated);
+}
+
+/// A texture-mapped mean free path: its exitance follows the texture's detail, which the grid
+/// does not see, so every pixel is queried, and the image is the one without interpolation,
+/// bit for bit.
+#[test]
+fn texture_mapped_materials_are_queried_at_every_pixel() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut scene = load_scene(&root.join("scenes/textured-mfp.toml")).unwrap();
+    scene.camera.width = 64;
+    scene.camera.height = 48;
+    scene.render.samples = SampleDensity::Count(3000).into();
+    let baked = bake(&scene, false).unwrap();
+    let queried = render(&scene, &options(&baked)).unwrap();
+    scene.render.interpolation = 4;
+    let r = render(&scene, &options(&baked)).unwrap();
+    assert!(queried.stats.queries > 1000);
+    assert_eq!(r.stats.interpolated, 0);
+    assert_eq!(r.stats.queries, queried.stats.queries);
+    assert!(r.pixels == queried.pixels);
 }
