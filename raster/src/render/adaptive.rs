@@ -186,15 +186,13 @@ impl Shading<'_> {
     /// differ (see the module docs), into `scratch.groups`; true if any fragment was split
     /// (otherwise the points are those of [`Shading::pixel`]).
     pub fn split_pixel(&self, x: u32, y: u32, scratch: &mut PixelScratch) -> bool {
-        let object_of = &self.prep.object_of;
         let PixelScratch {
             fragments,
             shadows,
             groups,
             ..
         } = scratch;
-        self.visibility
-            .resolve(x, y, |t| object_of[t as usize], fragments);
+        self.resolve(x, y, fragments);
         groups.groups.clear();
         let mut split = false;
         for (source, fragment) in fragments.iter().enumerate() {

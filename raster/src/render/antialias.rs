@@ -136,12 +136,7 @@ pub(super) fn refine(
         total.points += row.points;
         total.queries += row.queries;
         total.probes += row.probes;
-        let (t, r) = (&mut total.stats.traversal, row.stats.traversal);
-        t.nodes_opened += r.nodes_opened;
-        t.aggregates += r.aggregates;
-        t.samples += r.samples;
-        t.culled += r.culled;
-        total.stats.translucent_time += row.stats.translucent_time;
+        total.stats.add(&row.stats);
     }
     Ok(total)
 }

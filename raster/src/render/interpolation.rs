@@ -44,7 +44,7 @@
 
 use glam::Vec3;
 use lucent_core::Exitance;
-use lucent_core::stats::{NoStats, StatsSink};
+use lucent_core::stats::NoStats;
 use rayon::prelude::*;
 
 use super::RenderError;
@@ -175,8 +175,7 @@ impl ExitanceGrid {
         for row in rows_out {
             let (row, c) = row?;
             nodes.extend(row);
-            cost.stats.traversal.merge(&c.stats.traversal);
-            cost.stats.translucent_time += c.stats.translucent_time;
+            cost.stats.add(&c.stats);
             cost.queries += c.queries;
         }
         let mut grid = ExitanceGrid {
@@ -202,10 +201,7 @@ impl ExitanceGrid {
         scratch: &mut PixelScratch,
         stats: &mut S,
     ) -> Result<Option<Node>, RenderError> {
-        let object_of = &shading.prep.object_of;
-        shading
-            .visibility
-            .resolve(x, y, |t| object_of[t as usize], &mut scratch.fragments);
+        shading.resolve(x, y, &mut scratch.fragments);
         let [fragment] = scratch.fragments[..] else {
             return Ok(None);
         };

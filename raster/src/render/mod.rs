@@ -34,7 +34,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lucent_core::stats::{NoStats, QueryStats, StatsSink};
+use lucent_core::stats::{NoStats, QueryStats};
 use lucent_core::{IrradianceCache, QuerySettings};
 use rayon::prelude::*;
 
@@ -430,8 +430,7 @@ fn render_in_pool(
     // Shaded in place, one row per task: a single buffer, touched once (fresh pages cost a
     // fault each; rows gathered into a second buffer doubled that).
     let mut pixels = vec![PixelValue::default(); shaded.pixels() as usize];
-    let mut traversal = QueryStats::default();
-    let mut translucent_time = Duration::ZERO;
+    let mut counters = ShadingCounters::default();
     let (mut shading_points, mut queries, mut interpolated) = (0, 0, 0);
     let (mut probes, mut probed_pixels, mut refined_pixels) = (0, 0, 0);
     for (band, y0) in pixels
@@ -444,8 +443,7 @@ fn render_in_pool(
                 let rows = Region { y0, y1, ..shaded };
                 let (grid, cost) =
                     ExitanceGrid::build(&shading, settings, rows, options.collect_stats)?;
-                traversal.merge(&cost.stats.traversal);
-                translucent_time += cost.stats.translucent_time;
+                counters.add(&cost.stats);
                 queries += cost.queries;
                 Some(grid)
             }
@@ -480,8 +478,7 @@ fn render_in_pool(
             .collect();
         for row in rows {
             let row = row?;
-            traversal.merge(&row.stats.traversal);
-            translucent_time += row.stats.translucent_time;
+            counters.add(&row.stats);
             shading_points += row.points;
             queries += row.queries;
             interpolated += row.interpolated;
@@ -493,8 +490,7 @@ fn render_in_pool(
         let t = Instant::now();
         let refined =
             antialias::refine(&shading, &mut pixels, shaded, region, options.collect_stats)?;
-        traversal.merge(&refined.stats.traversal);
-        translucent_time += refined.stats.translucent_time;
+        counters.add(&refined.stats);
         shading_points += refined.points;
         queries += refined.queries;
         probes = refined.probes;
@@ -502,7 +498,7 @@ fn render_in_pool(
         probed_pixels = refined.flagged;
         timings.refine = t.elapsed();
     }
-    traversal.queries = queries;
+    counters.traversal.queries = queries;
     timings.shading = t.elapsed();
     timings.total = start.elapsed();
 
@@ -532,8 +528,8 @@ fn render_in_pool(
             probes,
             probed_pixels,
             refined_pixels,
-            traversal: options.collect_stats.then_some(traversal),
-            translucent_time: options.collect_stats.then_some(translucent_time),
+            traversal: options.collect_stats.then_some(counters.traversal),
+            translucent_time: options.collect_stats.then_some(counters.translucent_time),
             timings,
             threads,
             simd,

@@ -15,8 +15,8 @@ use glam::{Mat4, Vec2, Vec3};
 use lucent_core::internals::fresnel;
 use lucent_core::stats::{NoStats, QueryStats, StatsSink};
 use lucent_core::{
-    IrradianceCache, LocalQuadrature, LocalTerm, QuadratureLayout, QueryPlan, QuerySettings,
-    ShadingPoint,
+    Exitance, IrradianceCache, LocalQuadrature, LocalTerm, QuadratureLayout, QueryPlan,
+    QuerySettings, ShadingPoint,
 };
 
 use super::RenderError;
@@ -217,6 +217,14 @@ pub struct ShadingCounters {
     pub translucent_time: Duration,
 }
 
+impl ShadingCounters {
+    /// Adds another set of counters (a row's, a band's, a pass's) to these.
+    pub fn add(&mut self, other: &ShadingCounters) {
+        self.traversal.merge(&other.traversal);
+        self.translucent_time += other.translucent_time;
+    }
+}
+
 impl StatsSink for ShadingCounters {
     #[inline(always)]
     fn node(&mut self) {
@@ -314,10 +322,15 @@ impl Shading<'_> {
 
     /// Pixel (x, y)'s fragments into `scratch`, one unsplit shading point each.
     fn resolve_whole(&self, x: u32, y: u32, scratch: &mut PixelScratch) {
+        self.resolve(x, y, &mut scratch.fragments);
+        scratch.groups.whole(&scratch.fragments);
+    }
+
+    /// Pixel (x, y)'s fragments, keyed by object, into `fragments`.
+    pub(super) fn resolve(&self, x: u32, y: u32, fragments: &mut Vec<Fragment>) {
         let object_of = &self.prep.object_of;
         self.visibility
-            .resolve(x, y, |t| object_of[t as usize], &mut scratch.fragments);
-        scratch.groups.whole(&scratch.fragments);
+            .resolve(x, y, |t| object_of[t as usize], fragments);
     }
 
     /// [`Shading::pixel`], with the exitance blended from `grid` where it may be.
@@ -520,78 +533,17 @@ impl Shading<'_> {
                 let m = match blended {
                     Some(m) => m,
                     None => {
-                        let shading_point = ShadingPoint {
+                        let query = PointQuery {
+                            object: oc,
+                            shader,
+                            uniform,
+                            point,
                             position,
+                            normal,
                             irradiance: e,
+                            seed,
                         };
-                        let (local, m) = match uniform {
-                            Some(u) => (
-                                u.plan.local(),
-                                super::simd::query_planned(
-                                    &oc.cache,
-                                    &u.plan,
-                                    &shading_point,
-                                    stats,
-                                ),
-                            ),
-                            None => {
-                                let local = match (&oc.local, oc.uniform_k) {
-                                    (Some(_), _) if self.exact_local_integral => {
-                                        LocalTerm::exact(&point.profile, oc.alpha).map_err(|e| {
-                                            RenderError::Material(MaterialError::Params {
-                                                material: shader.name.clone(),
-                                                source: e,
-                                            })
-                                        })?
-                                    }
-                                    (Some(_), Some(term)) => term,
-                                    (Some(source), None) => source.lookup(point),
-                                    (None, _) => LocalTerm::NONE,
-                                };
-                                let m = match textured_plan {
-                                    Some(plan) => oc
-                                        .cache
-                                        .replan_into(plan, &point.profile, local)
-                                        .and_then(|()| {
-                                            super::simd::query_planned(
-                                                &oc.cache,
-                                                plan,
-                                                &shading_point,
-                                                stats,
-                                            )
-                                        }),
-                                    None => super::simd::query(
-                                        &oc.cache,
-                                        &point.profile,
-                                        &shading_point,
-                                        local,
-                                        &self.settings,
-                                        stats,
-                                    ),
-                                };
-                                (local, m)
-                            }
-                        };
-                        let m = m.map_err(|source| RenderError::Query { position, source })?;
-                        if m.refine {
-                            let q = match (&oc.quadrature, &oc.quadrature_layout) {
-                                (Some(q), _) => *q,
-                                (None, Some(layout)) => {
-                                    LocalQuadrature::with_layout(&point.profile, layout)
-                                }
-                                (None, None) => edge_refined::quadrature(&point.profile, oc.alpha),
-                            };
-                            let at = RefinePoint {
-                                position,
-                                normal,
-                                irradiance: e,
-                                local,
-                                seed,
-                            };
-                            edge_refined::refine(&lighting, &q, &at, shadows, m)
-                        } else {
-                            m
-                        }
+                        self.query(&query, textured_plan, &lighting, shadows, stats)?
                     }
                 };
                 out.exitance = m.total;
@@ -604,6 +556,107 @@ impl Shading<'_> {
         }
         Ok(out)
     }
+
+    /// The exitance at a translucent point by its cache query, refined at shadow edges
+    /// ([`edge_refined`]) where the query asks for it. `textured_plan` is re-made for the
+    /// point's material when the object has no uniform one.
+    fn query<S: ShadingStats>(
+        &self,
+        q: &PointQuery,
+        textured_plan: Option<&mut QueryPlan>,
+        lighting: &Lighting,
+        shadows: &mut ShadowHints,
+        stats: &mut S,
+    ) -> Result<Exitance, RenderError> {
+        let PointQuery {
+            object: oc,
+            shader,
+            point,
+            position,
+            ..
+        } = *q;
+        let shading_point = ShadingPoint {
+            position,
+            irradiance: q.irradiance,
+        };
+        let material_error = |e| {
+            RenderError::Material(MaterialError::Params {
+                material: shader.name.clone(),
+                source: e,
+            })
+        };
+        let (local, m) = match q.uniform {
+            Some(u) => (
+                u.plan.local(),
+                super::simd::query_planned(&oc.cache, &u.plan, &shading_point, stats),
+            ),
+            None => {
+                let local = match (&oc.local, oc.uniform_k) {
+                    (Some(_), _) if self.exact_local_integral => {
+                        LocalTerm::exact(&point.profile, oc.alpha).map_err(material_error)?
+                    }
+                    (Some(_), Some(term)) => term,
+                    (Some(source), None) => source.lookup(point),
+                    (None, _) => LocalTerm::NONE,
+                };
+                let m = match textured_plan {
+                    Some(plan) => {
+                        oc.cache
+                            .replan_into(plan, &point.profile, local)
+                            .and_then(|()| {
+                                super::simd::query_planned(&oc.cache, plan, &shading_point, stats)
+                            })
+                    }
+                    None => super::simd::query(
+                        &oc.cache,
+                        &point.profile,
+                        &shading_point,
+                        local,
+                        &self.settings,
+                        stats,
+                    ),
+                };
+                (local, m)
+            }
+        };
+        let m = m.map_err(|source| RenderError::Query { position, source })?;
+        if !m.refine {
+            return Ok(m);
+        }
+        let quadrature = match (&oc.quadrature, &oc.quadrature_layout) {
+            (Some(quadrature), _) => *quadrature,
+            (None, Some(layout)) => LocalQuadrature::with_layout(&point.profile, layout),
+            (None, None) => edge_refined::quadrature(&point.profile, oc.alpha),
+        };
+        let at = RefinePoint {
+            position,
+            normal: q.normal,
+            irradiance: q.irradiance,
+            local,
+            seed: q.seed,
+        };
+        Ok(edge_refined::refine(lighting, &quadrature, &at, shadows, m))
+    }
+}
+
+/// A translucent point's inputs to its cache query.
+struct PointQuery<'p> {
+    /// The object's cache, smoothing radius and local-term sources.
+    object: &'p ObjectCache,
+    /// The object's material (for its name in errors).
+    shader: &'p TranslucentShader,
+    /// The object's material and plan where they are the same at every point.
+    uniform: Option<&'p UniformMaterial>,
+    /// The material at the point.
+    point: &'p PointMaterial,
+    /// Position x.
+    position: Vec3,
+    /// Unit shading normal at x.
+    normal: Vec3,
+    /// E(x), where the method uses it.
+    irradiance: Vec3,
+    /// The point's seed.
+    seed: u64,
 }
 
 /// The cosine of the outgoing direction for the Fresnel transmittance F_t(η, cos θ_o).
