@@ -591,6 +591,46 @@ def texture_seeds():
     write(t, "unrecognised-text", bytes([DETECT_PNG]) + b"not an image")
 
 
+def crop_seed(scene=0, method=3, size=(40, 30), aa=1, step=1, tolerance=0.25, vfov=30.0,
+              crop=(0, 0, 40, 30), threads_swapped=False):
+    """One crops_match_the_whole_render input (layout in tests/src/fuzz_props/crops.rs)."""
+    w, h = size
+    x0, y0, x1, y1 = crop
+    return bytes([
+        scene | (method << 1),
+        w - 1, h - 1,
+        aa - 1,
+        step - 1,
+        round(tolerance * 32),
+        round((vfov - 6.0) * 8),
+        x0, y0, x1 - x0 - 1, y1 - y0 - 1,
+        int(threads_swapped),
+    ])
+
+
+def crop_seeds():
+    t = "crops_match_the_whole_render"
+    # The tiles test's images: the sphere filling the view, its shadow edge down the middle.
+    write(t, "sphere-interpolated-inner-tile",
+          crop_seed(step=4, tolerance=1.0, vfov=10.0, crop=(20, 7, 29, 15)))
+    write(t, "sphere-interpolated-second-pass-strip",
+          crop_seed(aa=3, step=3, tolerance=1.0, vfov=10.0, crop=(14, 7, 15, 30),
+                    threads_swapped=True))
+    # A one-column crop at the image's left edge, whose blocks' right corners lie outside it
+    # (found the grid clamped to the crop instead of the image).
+    write(t, "sphere-interpolated-first-column",
+          crop_seed(aa=3, step=3, tolerance=1.0, vfov=10.0, crop=(0, 7, 1, 14)))
+    write(t, "sphere-second-pass-horizon-row", crop_seed(aa=2, crop=(0, 15, 14, 16)))
+    write(t, "sphere-hierarchical-step-16-tiny",
+          crop_seed(method=0, size=(3, 2), step=16, tolerance=7.9, vfov=10.0, crop=(1, 1, 3, 2)))
+    write(t, "sphere-edge-aware-odd-step", crop_seed(method=2, size=(37, 23), step=5,
+                                                     tolerance=0.5, vfov=12.0,
+                                                     crop=(11, 4, 30, 19)))
+    write(t, "textured-interpolated", crop_seed(scene=1, size=(32, 24), aa=2, step=4,
+                                                crop=(5, 3, 21, 17)))
+    write(t, "textured-local-global", crop_seed(scene=1, method=1, size=(24, 24), crop=(0, 12, 24, 24)))
+
+
 if __name__ == "__main__":
     cache_seeds()
     table_seeds()
@@ -602,3 +642,4 @@ if __name__ == "__main__":
     shadow_seeds()
     convexity_seeds()
     texture_seeds()
+    crop_seeds()

@@ -96,6 +96,11 @@ fn texture_load_never_panics() {
     replay("texture_load_never_panics");
 }
 
+#[test]
+fn crops_match_the_whole_render() {
+    replay("crops_match_the_whole_render");
+}
+
 /// Every fuzz target has a property and a corpus, and every corpus a target: a target added
 /// without its replay (or a misspelt directory) fails here.
 #[test]
