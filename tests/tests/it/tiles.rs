@@ -3,7 +3,8 @@
 //! single render: the PNG, and the EXR with its alpha and every layer. At `aa = 1` and with the
 //! second shading pass (`aa = 3`), whose contrast test reads each pixel's neighbours, so that
 //! the shadow edge crossing the tile borders tests the margin the tiles render; and with
-//! exitance interpolation, whose grid crosses the tile borders.
+//! exitance interpolation, whose grid crosses the tile borders. The fuzz target
+//! `crops_match_the_whole_render` searches other sizes, settings and crops.
 
 use std::path::{Path, PathBuf};
 
