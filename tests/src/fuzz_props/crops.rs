@@ -51,7 +51,12 @@ fn baked(index: usize) -> &'static (Scene, Vec<ObjectSamples>) {
     static BAKED: [OnceLock<(Scene, Vec<ObjectSamples>)>; 2] = [OnceLock::new(), OnceLock::new()];
     BAKED[index].get_or_init(|| {
         // A coarser sphere (48 segments, not 128): every render builds its BVH.
-        let text = SCENES[index].replace("segments = 128", "segments = 48");
+        let full = SCENES[index];
+        assert!(
+            index != 0 || full.contains("segments = 128"),
+            "the sphere scene no longer says `segments = 128`; update the coarsening"
+        );
+        let text = full.replace("segments = 128", "segments = 48");
         let mut scene = parse_scene(&text, &fuzz_origin())
             .unwrap_or_else(|e| panic!("scene {index} does not parse: {e}"));
         scene.render.samples = SampleDensity::Count(SAMPLES[index]).into();
