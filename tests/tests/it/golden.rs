@@ -272,7 +272,14 @@ fn images_and_baked_samples_are_identical_for_any_thread_count() {
         let mut baked: Vec<Vec<u8>> = Vec::new();
         for threads in [1, 2, 8, 2] {
             scene.render.threads = Some(threads);
-            let r = render(&scene, &RenderOptions::default()).unwrap();
+            // Each thread count bakes its own samples and renders from them (a render without
+            // `baked` would place and light the same samples a second time).
+            let sets = bake(&scene, false).unwrap();
+            let options = RenderOptions {
+                baked: Some(&sets),
+                ..RenderOptions::default()
+            };
+            let r = render(&scene, &options).unwrap();
             images.push(
                 r.pixels
                     .iter()
@@ -280,7 +287,6 @@ fn images_and_baked_samples_are_identical_for_any_thread_count() {
                     .map(f32::to_bits)
                     .collect(),
             );
-            let sets = bake(&scene, false).unwrap();
             let path = dir.join(format!("{name}-{threads}.ply"));
             let names: Vec<String> = scene.objects.iter().map(|o| o.name.clone()).collect();
             write_baked(&path, &sets, &names, &["golden test".to_string()]).unwrap();
