@@ -400,16 +400,23 @@ impl<'a> Lighting<'a> {
             return self.point(p, n, center, intensity, 1.0, hint);
         }
         let axis = to_center / d;
-        let sin2_max = (radius * radius / d2).min(1.0);
+        let sin2_max = ((radius / d) * (radius / d)).min(1.0);
         let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-        let solid_angle = std::f32::consts::TAU * (1.0 - cos_max);
-        let radiance = intensity / (std::f32::consts::PI * radius * radius);
+        // 1 − cos θ_max without cancellation: in f32, 1 − cos θ_max of a light 10⁻³ of its
+        // distance across came out twice too large (or 0 below that).
+        let one_minus_cos_max = sin2_max / (1.0 + cos_max);
+        // Radiance I/(π r²) times the cone's solid angle 2π(1 − cos θ_max)
+        // = 2π r²/(d²(1 + cos θ_max)): the r² cancel, so a vanishing radius gives the point
+        // light's I/d² instead of ∞ · 0.
+        let radiance_times_solid_angle = intensity * (2.0 / (d2 * (1.0 + cos_max)));
         let (t, b) = axis.any_orthonormal_pair();
         let mut sum = 0.0;
         let count = samples.max(1);
         for u in strata(count, seed) {
-            let cos_a = 1.0 - u.x * (1.0 - cos_max);
-            let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+            // 1 − cos α, and sin²α = (1 − cos α)(1 + cos α), each without cancellation.
+            let one_minus_cos_a = u.x * one_minus_cos_max;
+            let cos_a = 1.0 - one_minus_cos_a;
+            let sin_a = (one_minus_cos_a * (2.0 - one_minus_cos_a)).max(0.0).sqrt();
             let phi = std::f32::consts::TAU * u.y;
             let dir =
                 (t * (sin_a * phi.cos()) + b * (sin_a * phi.sin()) + axis * cos_a).normalize();
@@ -419,7 +426,8 @@ impl<'a> Lighting<'a> {
             }
             // Distance to the near side of the sphere along dir.
             let along = d * cos_a;
-            let t_hit = along - (radius * radius - (d2 - along * along)).max(0.0).sqrt();
+            let off_axis = d * sin_a;
+            let t_hit = along - ((radius - off_axis) * (radius + off_axis)).max(0.0).sqrt();
             if self.visible(p, n, dir, t_hit.max(0.0) * SHORTEN, hint) {
                 sum += cos;
             }
@@ -429,7 +437,7 @@ impl<'a> Lighting<'a> {
         }
         Some(Incident {
             direction: axis,
-            irradiance: radiance * (solid_angle * sum / count as f32),
+            irradiance: radiance_times_solid_angle * (sum / count as f32),
         })
     }
 }
@@ -733,6 +741,28 @@ mod tests {
             .x;
         // Exact for a facing surface: E = L π sin²θ_max = I/d².
         assert!((es - ep).abs() / ep < 0.01, "{es} vs {ep}");
+    }
+
+    #[test]
+    fn a_vanishing_sphere_light_is_a_point_light() {
+        // r² underflows f32 at these radii: I/(π r²) alone is ∞ and the cone's solid angle 0.
+        let point = [point_light(Vec3::new(1.0, 0.0, 4.0), 16.0)];
+        let ep = Lighting::new(&point, None, 1.0).irradiance(Vec3::ZERO, Vec3::Z, 7);
+        for radius in [1e-3, 1e-12, 1e-20, 1e-30, 1e-45] {
+            let sphere = [Light::Sphere {
+                center: Vec3::new(1.0, 0.0, 4.0),
+                radius,
+                color: Vec3::ONE,
+                intensity: 16.0,
+                samples: 16,
+            }];
+            let es = Lighting::new(&sphere, None, 1.0).irradiance(Vec3::ZERO, Vec3::Z, 7);
+            assert!(es.is_finite(), "radius {radius}: {es}");
+            assert!(
+                (es - ep).abs().max_element() <= 2e-3 * ep.x,
+                "radius {radius}: {es} vs {ep}"
+            );
+        }
     }
 
     #[test]
