@@ -10,11 +10,13 @@ use super::BenchArgs;
 use super::{BakeArgs, RenderArgs, SamplesArg};
 #[cfg(feature = "harness")]
 use crate::bench::{self, BenchConfig, BenchScene};
-use crate::output::{Placement, Region, refuse_read_only, write_exr, write_exr_tile, write_png};
+use crate::output::{
+    Placement, Region, output_target, refuse_read_only, write_exr, write_exr_tile, write_png,
+};
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
     MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene,
-    default_scene, load_scene,
+    default_scene, files_read, load_scene,
 };
 
 /// Loads the scene named on the command line, or the built-in default, printing its
@@ -25,7 +27,7 @@ fn load(path: Option<&Path>) -> Result<Scene, String> {
         None => default_scene(),
     };
     for warning in &scene.warnings {
-        eprintln!("warning: {warning}");
+        errln!("warning: {warning}");
     }
     Ok(scene)
 }
@@ -192,12 +194,17 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
 }
 
 /// Checks, before rendering, that every output path can be written: it names a file, its
-/// directory exists, it is not itself a directory nor a read-only file, and no path is given
-/// twice. Each write is
-/// atomic on its own, but a render writes the PNG and then the EXR: without this check, an EXR
-/// path in a missing directory failed only after the PNG had been replaced (exit 1 with a
-/// changed file), and the whole render was wasted.
-pub(super) fn check_outputs(paths: &[&Path]) -> Result<(), String> {
+/// directory exists, it is not itself a directory, a device, a pipe nor a read-only file, no
+/// path is given twice, and none is one of the command's inputs — `inputs`, or any file the
+/// scene loader read ([`files_read`]: the scene, its meshes, material libraries and
+/// textures), compared as canonical paths, so that `-o scene.toml` or a tile named as the
+/// merged EXR is refused instead of replaced. Each write is atomic on its own, but a render
+/// writes the PNG and then the EXR: without this check, an EXR path in a missing directory
+/// failed only after the PNG had been replaced (exit 1 with a changed file), and the whole
+/// render was wasted.
+pub(super) fn check_outputs(paths: &[&Path], inputs: &[&Path]) -> Result<(), String> {
+    let mut read = files_read();
+    read.extend(inputs.iter().filter_map(|p| std::fs::canonicalize(p).ok()));
     for (i, path) in paths.iter().enumerate() {
         let shown = path.display();
         if path.file_name().is_none() {
@@ -219,7 +226,16 @@ pub(super) fn check_outputs(paths: &[&Path]) -> Result<(), String> {
         if paths[..i].contains(path) {
             return Err(format!("{shown}: given as both the PNG and the EXR output"));
         }
-        refuse_read_only(path).map_err(|e| e.to_string())?;
+        let target = output_target(path).map_err(|e| e.to_string())?;
+        refuse_read_only(&target).map_err(|e| e.to_string())?;
+        if let Ok(canonical) = std::fs::canonicalize(&target)
+            && read.contains(&canonical)
+        {
+            return Err(format!(
+                "{shown}: cannot write there: it is one of this command's inputs; name another \
+                 output file"
+            ));
+        }
     }
     Ok(())
 }
@@ -248,6 +264,29 @@ fn seconds(d: std::time::Duration) -> String {
     format!("{:.2} s", d.as_secs_f64())
 }
 
+/// Fails when a pixel's radiance, exitance or irradiance is infinite or NaN: a light's
+/// intensity or a material's values beyond what 32-bit floats hold. Nothing is written then,
+/// rather than an image with holes in it.
+fn refuse_non_finite(result: &render::Render) -> Result<(), String> {
+    let bad = |p: &render::PixelValue| {
+        !(p.color.is_finite() && p.exitance.is_finite() && p.irradiance.is_finite())
+    };
+    let count = result.pixels.iter().filter(|p| bad(p)).count();
+    let Some(first) = result.pixels.iter().position(bad) else {
+        return Ok(());
+    };
+    let region = &result.region;
+    let width = (region.x1 - region.x0) as usize;
+    let (x, y) = (
+        region.x0 as usize + first % width,
+        region.y0 as usize + first / width,
+    );
+    Err(format!(
+        "{count} pixel(s) came out infinite or NaN, the first at ({x}, {y}): a light's \
+         intensity or a material's values are too large for 32-bit floats; nothing was written"
+    ))
+}
+
 /// `lucent render`.
 pub fn render(args: &RenderArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
@@ -261,7 +300,8 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         .flatten()
         .map(|p| p.as_path())
         .collect();
-    check_outputs(&outputs)?;
+    let inputs: Vec<&Path> = args.samples_from.iter().map(|p| p.as_path()).collect();
+    check_outputs(&outputs, &inputs)?;
     let baked = match &args.samples_from {
         Some(path) => {
             let groups = read_baked(path).map_err(|e| e.to_string())?;
@@ -277,6 +317,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         ..RenderOptions::default()
     };
     let result = render::render(&scene, &options).map_err(|e| e.to_string())?;
+    refuse_non_finite(&result)?;
 
     let mut written: Vec<String> = Vec::new();
     if let Some(png) = &scene.output.png {
@@ -355,6 +396,7 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
     if let Some(method) = args.method {
         scene.render.method = method;
     }
+    check_outputs(&[&args.output], &[])?;
     let start = std::time::Instant::now();
     let (sets, plan) =
         render::bake_planned(&scene, !args.quiet, true).map_err(|e| e.to_string())?;
@@ -427,7 +469,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
         let files = bench::replot(&args.output).map_err(|e| format!("bench: {e}"))?;
         if !args.quiet {
             for file in files {
-                eprintln!("{}", file.display());
+                errln!("{}", file.display());
             }
         }
         return Ok(());
@@ -442,7 +484,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
         let quiet = args.quiet;
         bench::run_profiles(&config, &args.output, &mut |line| {
             if !quiet {
-                eprintln!("{line}");
+                errln!("{line}");
             }
         })
         .map_err(|e| format!("bench: {e}"))?;
@@ -461,7 +503,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
         let quiet = args.quiet;
         bench::run_peer(&peer, &args.output, &mut |line| {
             if !quiet {
-                eprintln!("{line}");
+                errln!("{line}");
             }
         })
         .map_err(|e| format!("bench: {e}"))?;
@@ -507,7 +549,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
     let quiet = args.quiet;
     bench::run(&config, &args.output, &mut |line| {
         if !quiet {
-            eprintln!("{line}");
+            errln!("{line}");
         }
     })
     .map_err(|e| format!("bench: {e}"))?;

@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use super::CompareArgs;
+use super::commands::check_outputs;
 use crate::output::image::{LAYER_EXITANCE, LAYER_IRRADIANCE};
 use crate::output::{
     ErrorMetric, ErrorStats, HeatmapOptions, HeatmapScale, LayerData, RgbImage,
@@ -73,6 +74,11 @@ fn print_stats(region: &str, s: &ErrorStats) -> Result<(), String> {
 
 /// `lucent compare`.
 pub fn compare(args: &CompareArgs) -> Result<(), String> {
+    if let Some(out) = &args.heatmap {
+        let mut inputs = vec![args.test.as_path(), args.reference.as_path()];
+        inputs.extend(args.noise_with.iter().map(|p| p.as_path()));
+        check_outputs(&[out], &inputs)?;
+    }
     let test = read(&args.test)?;
     let reference = read(&args.reference)?;
     let (width, height) = reference.image.size();

@@ -21,7 +21,8 @@ pub fn merge(args: &MergeArgs) -> Result<(), String> {
         .flatten()
         .map(|p| p.as_path())
         .collect();
-    check_outputs(&outputs)?;
+    let tiles: Vec<&std::path::Path> = args.tiles.iter().map(|p| p.as_path()).collect();
+    check_outputs(&outputs, &tiles)?;
     for (i, path) in args.tiles.iter().enumerate() {
         if args.tiles[..i].contains(path) {
             return Err(format!("{}: given twice", path.display()));

@@ -14,6 +14,14 @@ macro_rules! outln {
     };
 }
 
+/// `eprintln!` that ignores a failed write: a closed standard error must neither panic
+/// (exit 101) nor stop a render over a warning.
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        $crate::cli::write_error_line(format_args!($($arg)*))
+    };
+}
+
 mod commands;
 #[cfg(feature = "harness")]
 mod compare;
@@ -36,6 +44,11 @@ fn write_line(line: std::fmt::Arguments) -> Result<(), String> {
         }
         _ => Ok(()),
     }
+}
+
+fn write_error_line(line: std::fmt::Arguments) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
 /// Render translucent materials: point-based subsurface scattering (Jensen & Buhler 2002,
@@ -338,7 +351,7 @@ pub fn main() -> i32 {
     match result {
         Ok(()) => 0,
         Err(message) => {
-            eprintln!("error: {message}");
+            errln!("error: {message}");
             1
         }
     }

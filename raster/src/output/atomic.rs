@@ -7,13 +7,17 @@
 //! byte-identical. A reader never sees a half-written PNG, EXR, PLY, SVG or report, even if
 //! `lucent` is killed mid-write. Every file lucent writes goes through here.
 //!
+//! The target is the file the path names: a symbolic link is followed and the file it points
+//! to replaced, not the link; a device (`/dev/null`), pipe or socket is refused, since the
+//! rename would put a plain file in its place ([`output_target`]).
+//!
 //! An existing target whose permissions say read-only is refused ([`OutputError::ReadOnly`])
 //! before anything is written: a rename replaces a file whatever its permissions, which would
 //! silently overwrite a result its owner protected.
 
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::OutputError;
 
@@ -38,11 +42,12 @@ where
             "the output path does not name a file",
         ));
     };
-    let dir = match path.parent() {
+    let target = output_target(path)?;
+    let dir = match target.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    refuse_read_only(path)?;
+    refuse_read_only(&target)?;
 
     // `.<name>.XXXXXX.tmp`: hidden, and recognisably the target's. The handle deletes the
     // file when dropped — on every early return below and when `write` panics.
@@ -74,7 +79,7 @@ where
 
     let temp_path = temp.path().to_path_buf();
     // On failure the error hands the temporary file back, and dropping it removes it.
-    temp.persist(path).map_err(|e| {
+    temp.persist(&target).map_err(|e| {
         OutputError::io(
             path,
             format!(
@@ -92,6 +97,42 @@ where
         let _ = d.sync_all();
     }
     Ok(())
+}
+
+/// The file that writing `path` replaces: `path` itself, or the file a symbolic link names
+/// (which must exist). Refused: a directory, and anything else that is not a regular file — a
+/// device such as `/dev/null`, a pipe or a socket, which the rename of [`write_atomically`]
+/// would replace with a plain file (as the superuser, even `/dev/null`).
+pub fn output_target(path: &Path) -> Result<PathBuf, OutputError> {
+    // `out.png/` names a directory: the rename would fail only after the render.
+    if path.to_string_lossy().ends_with(std::path::is_separator) {
+        return Err(OutputError::invalid(
+            path,
+            "the output path ends with a separator, so it names a directory, not a file",
+        ));
+    }
+    let target = match std::fs::symlink_metadata(path) {
+        Ok(meta) if meta.file_type().is_symlink() => std::fs::canonicalize(path).map_err(|e| {
+            OutputError::io(
+                path,
+                "following the symbolic link failed (the file it names must exist)",
+                e,
+            )
+        })?,
+        _ => path.to_path_buf(),
+    };
+    match std::fs::metadata(&target) {
+        Ok(meta) if meta.is_dir() => Err(OutputError::invalid(
+            path,
+            "cannot write there: it is a directory",
+        )),
+        Ok(meta) if !meta.is_file() => Err(OutputError::invalid(
+            path,
+            "cannot write there: it is not a regular file (a device, pipe or socket), which \
+             lucent would replace with a plain file",
+        )),
+        _ => Ok(target),
+    }
 }
 
 /// Writes the text `text` to `path` atomically (see [`write_atomically`]): reports, CSV
@@ -232,6 +273,11 @@ pub(crate) mod tests {
     fn path_without_file_name_is_rejected() {
         let err = write_atomically(Path::new("/"), |_| Ok(())).unwrap_err();
         assert!(err.to_string().contains("does not name a file"), "{err}");
+        let dir = TestDir::new("atomic-slash");
+        let slash = dir.0.join("out.png/");
+        let err = write_atomically(&slash, |_| Ok(())).unwrap_err();
+        assert!(err.to_string().contains("ends with a separator"), "{err}");
+        assert!(dir.entries().is_empty(), "{:?}", dir.entries());
     }
 
     #[test]
@@ -292,6 +338,60 @@ pub(crate) mod tests {
         })
         .unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"new");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symbolic_link_is_followed_and_kept() {
+        let dir = TestDir::new("atomic-symlink");
+        let target = dir.path("real.png");
+        fs::write(&target, b"old").unwrap();
+        let link = dir.path("link.png");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        write_atomically(&link, |w| {
+            w.write_all(b"new")
+                .map_err(|e| OutputError::io(&link, "write", e))
+        })
+        .unwrap();
+        assert!(
+            fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(fs::read(&target).unwrap(), b"new");
+        assert_eq!(
+            dir.entries(),
+            vec!["link.png".to_string(), "real.png".to_string()]
+        );
+
+        let dangling = dir.path("dangling.png");
+        std::os::unix::fs::symlink(dir.path("missing.png"), &dangling).unwrap();
+        let err = write_atomically(&dangling, |_| Ok(())).unwrap_err();
+        assert!(err.to_string().contains("symbolic link"), "{err}");
+        assert!(!dir.path("missing.png").exists());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn pipes_are_refused() {
+        // A pipe stands for every non-regular file (a device is not tried: were the check
+        // broken, the test would replace it).
+        let dir = TestDir::new("atomic-special");
+        let fifo = dir.path("pipe.png");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo failed");
+        let mut called = false;
+        let err = write_atomically(&fifo, |_| {
+            called = true;
+            Ok(())
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("not a regular file"), "{err}");
+        assert!(!called);
+        let kind = fs::symlink_metadata(&fifo).unwrap().file_type();
+        assert!(std::os::unix::fs::FileTypeExt::is_fifo(&kind));
+        assert_eq!(dir.entries(), vec!["pipe.png".to_string()]);
     }
 
     #[cfg(unix)]

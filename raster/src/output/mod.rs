@@ -40,7 +40,9 @@ pub mod regions;
 pub mod srgb;
 pub mod tile;
 
-pub use atomic::{WriteSeek, refuse_read_only, write_atomically, write_text_atomically};
+pub use atomic::{
+    WriteSeek, output_target, refuse_read_only, write_atomically, write_text_atomically,
+};
 #[cfg(feature = "harness")]
 pub use compare::{ErrorStats, RELATIVE_L1_OFFSET, compare};
 pub use error::OutputError;

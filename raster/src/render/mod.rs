@@ -253,7 +253,11 @@ pub fn bake_planned(
 fn warn_once(print: bool, plan: Option<&DensityPlan>, scene: &Scene) -> Option<String> {
     let warning = plan?.warning(scene.render.method, scene.render.smoothing)?;
     if print {
-        eprintln!("warning: {warning}");
+        // A closed standard error must not stop the render.
+        let _ = std::io::Write::write_fmt(
+            &mut std::io::stderr().lock(),
+            format_args!("warning: {warning}\n"),
+        );
     }
     Some(warning)
 }

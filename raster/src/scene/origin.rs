@@ -8,6 +8,7 @@
 use std::borrow::Cow;
 use std::io::Read;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Largest file the loader reads (scene, mesh or texture): 1 GiB.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
@@ -91,11 +92,35 @@ impl SceneOrigin {
     }
 }
 
-/// Reads a whole file, refusing files larger than `limit` bytes.
+/// Every file [`read_limited`] has read in this process (scenes, meshes, material libraries,
+/// textures, glTF buffers), as canonical paths: a command refuses to write its outputs over
+/// any of them.
+static FILES_READ: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// The files the scene loader has read so far in this process, as canonical paths (see
+/// [`read_limited`]): what a command must not overwrite.
+pub fn files_read() -> Vec<PathBuf> {
+    FILES_READ.lock().map(|f| f.clone()).unwrap_or_default()
+}
+
+/// Reads a whole file, refusing files larger than `limit` bytes and anything that is not a
+/// regular file: a device such as `/dev/zero` would be read to the limit, a pipe would block.
+/// Records the file in [`files_read`].
 pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, std::io::Error> {
     let too_large =
         |message: String| std::io::Error::new(std::io::ErrorKind::FileTooLarge, message);
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a directory, device, pipe or socket)",
+        ));
+    }
     let file = std::fs::File::open(path)?;
+    if let (Ok(canonical), Ok(mut read)) = (std::fs::canonicalize(path), FILES_READ.lock())
+        && !read.contains(&canonical)
+    {
+        read.push(canonical);
+    }
     let len = file.metadata()?.len();
     if len > limit {
         return Err(too_large(format!(
@@ -124,6 +149,34 @@ fn normalise(path: &str) -> &str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Only regular files are read (a device would be read to the limit, a pipe would block),
+    /// and each file read is recorded once, canonically.
+    #[cfg(unix)]
+    #[test]
+    fn only_regular_files_are_read_and_each_is_recorded() {
+        let dir = std::env::temp_dir().join(format!("lucent-origin-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pipe = dir.join("pipe.obj");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&pipe)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        for special in [pipe.as_path(), dir.as_path(), Path::new("/dev/zero")] {
+            let err = read_limited(special, 1 << 20).expect_err("not a regular file");
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+        }
+        let file = dir.join("m.obj");
+        std::fs::write(&file, b"v 0 0 0").unwrap();
+        let relative = dir.join(".").join("m.obj");
+        assert_eq!(read_limited(&file, 100).unwrap(), b"v 0 0 0");
+        assert_eq!(read_limited(&relative, 100).unwrap(), b"v 0 0 0");
+        let canonical = std::fs::canonicalize(&file).unwrap();
+        let read = files_read();
+        assert_eq!(read.iter().filter(|p| **p == canonical).count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn file_origin_resolves_next_to_the_scene() {

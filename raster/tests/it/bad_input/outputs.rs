@@ -1,7 +1,7 @@
 //! Output paths that cannot be written, and `compare` on bad images: nothing is written or
 //! replaced, and no temporary file is left behind.
 
-use super::harness::{PREVIOUS, Sandbox, render};
+use super::harness::{CONSTANT, PREVIOUS, Sandbox, render, scene};
 
 /// PNG and EXR paths in a missing directory, naming a directory, or the same file twice:
 /// rejected before rendering, both outputs untouched.
@@ -193,4 +193,123 @@ fn command_line_outputs_replace_the_scenes() {
             assert_eq!(p.to_array(), [0.0; 3]);
         }
     }
+}
+
+/// An output that is one of the command's own inputs is refused before anything is read or
+/// rendered, whichever option names it: `-o` the scene, the scene's `[output]` its mesh,
+/// `--exr` the `--samples-from` file, bake's `-o` the scene, merge's `--exr` a tile, compare's
+/// heat map the test image.
+#[test]
+fn outputs_never_replace_inputs() {
+    let needle = "cannot write there: it is one of this command's inputs";
+    let sb = Sandbox::new("out-inputs");
+    sb.fails(&render(&["-o", "scene.toml"]), 1, &["scene.toml", needle]);
+    sb.fails(
+        &["bake", "scene.toml", "-q", "-o", "./scene.toml"],
+        1,
+        &["./scene.toml", needle],
+    );
+    sb.write("samples.ply", PREVIOUS);
+    sb.fails(
+        &render(&["--samples-from", "samples.ply", "--exr", "samples.ply"]),
+        1,
+        &["samples.ply", needle],
+    );
+    sb.fails(
+        &["merge", "out.exr", "--exr", "out.exr"],
+        1,
+        &["out.exr", needle],
+    );
+    sb.fails(
+        &["compare", "out.png", "out.exr", "--heatmap", "out.png"],
+        1,
+        &["out.png", needle],
+    );
+
+    let text =
+        scene("mesh = \"tri.obj\"", CONSTANT).replace("png = \"out.png\"", "png = \"tri.obj\"");
+    let sb = Sandbox::with_scene("out-input-mesh", &text);
+    sb.write("tri.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    sb.fails(&["scene.toml", "-q"], 1, &["tri.obj", needle]);
+}
+
+/// A symbolic link as the output writes the file it names and stays a link; a pipe is
+/// refused (the rename would replace it with a plain file, as it would `/dev/null`), and so is
+/// a path ending in a separator, before rendering.
+#[cfg(unix)]
+#[test]
+fn links_are_followed_and_pipes_refused() {
+    let sb = Sandbox::new("out-special");
+    std::os::unix::fs::symlink("out.png", sb.path("link.png")).unwrap();
+    sb.succeeds(&render(&["-o", "link.png"]));
+    assert!(sb.read("out.png").starts_with(b"\x89PNG"));
+    let link = std::fs::symlink_metadata(sb.path("link.png")).unwrap();
+    assert!(link.file_type().is_symlink());
+    std::fs::remove_file(sb.path("link.png")).unwrap();
+    sb.reset_outputs();
+
+    sb.fails(&render(&["-o", "out.png/"]), 1, &["ends with a separator"]);
+
+    // Not through `fails`: its snapshot of the directory would block reading the pipe.
+    let made = std::process::Command::new("mkfifo")
+        .arg(sb.path("pipe.png"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let out = sb.run(&render(&["-o", "pipe.png"]));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("pipe.png: cannot write there: it is not a regular file"),
+        "{stderr}"
+    );
+    let kind = std::fs::symlink_metadata(sb.path("pipe.png"))
+        .unwrap()
+        .file_type();
+    assert!(std::os::unix::fs::FileTypeExt::is_fifo(&kind));
+    assert_eq!(sb.read("out.png"), PREVIOUS);
+}
+
+/// A closed standard error: an error still exits 1 (not a panic, 101), and a render that has a
+/// warning to print still writes its image.
+#[test]
+fn a_closed_standard_error_is_not_a_crash() {
+    let sb = Sandbox::new("out-stderr");
+    let run = |args: &[&str]| {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+            .args(args)
+            .current_dir(sb.path(""))
+            .stderr(writer)
+            .stdout(std::process::Stdio::null())
+            .status()
+            .unwrap()
+    };
+    assert_eq!(run(&["missing.toml"]).code(), Some(1));
+    // 10 samples on the sphere: far too few, which the renderer warns about.
+    let text = scene(super::harness::SPHERE, CONSTANT).replace("samples = 500", "samples = 10");
+    std::fs::write(sb.path("warn.toml"), text).unwrap();
+    assert_eq!(
+        run(&["warn.toml", "-q", "-o", "warned.png"]).code(),
+        Some(0)
+    );
+    assert!(sb.read("warned.png").starts_with(b"\x89PNG"));
+}
+
+/// A light so bright and near that a Lambert surface's irradiance overflows f32 (3·10³⁸ W/sr
+/// at 0.4 units) is an error naming the cause, and nothing is written. (On a translucent
+/// object the irradiance samples refuse it first.)
+#[test]
+fn infinite_pixels_are_an_error() {
+    let text = scene(super::harness::SPHERE, CONSTANT)
+        .replace("intensity = 25.0", "intensity = 3e38")
+        .replace("position = [0.0, -3.0, 5.0]", "position = [0.0, -0.9, 0.5]")
+        .replace("material = \"m\"", "material = \"grey\"");
+    let sb = Sandbox::with_scene("out-infinite", &text);
+    sb.fails(
+        &["scene.toml", "-q"],
+        1,
+        &["infinite or NaN", "nothing was written"],
+    );
 }
