@@ -15,8 +15,8 @@ use crate::output::{
 };
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
-    MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, SampleDensity, SampleRequest, Scene,
-    default_scene, files_read, load_scene,
+    MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_THREADS, SampleDensity,
+    SampleRequest, Scene, default_scene, files_read, load_scene,
 };
 
 /// Loads the scene named on the command line, or the built-in default, printing its
@@ -91,13 +91,28 @@ fn density(
     Ok(())
 }
 
+/// `--seed`: the range a scene file's `seed` holds (TOML integers are signed 64-bit), so that
+/// a seed given on the command line can be written into a scene.
+fn seed(seed: Option<u64>, scene: &mut Scene) -> Result<(), String> {
+    if let Some(seed) = seed {
+        check(
+            seed <= i64::MAX as u64,
+            "--seed",
+            seed,
+            &format!("between 0 and {}", i64::MAX),
+        )?;
+        scene.render.seed = seed;
+    }
+    Ok(())
+}
+
 fn threads(n: Option<usize>, scene: &mut Scene) -> Result<(), String> {
     if let Some(n) = n {
         check(
-            (1..=4096).contains(&n),
+            n >= 1 && n as i64 <= MAX_THREADS,
             "--threads",
             n,
-            "between 1 and 4096",
+            &format!("between 1 and {MAX_THREADS}"),
         )?;
         scene.render.threads = Some(n);
     }
@@ -136,9 +151,7 @@ fn apply(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
         check((1..=8).contains(&aa), "--aa", aa, "between 1 and 8")?;
         scene.render.aa = aa;
     }
-    if let Some(seed) = args.seed {
-        scene.render.seed = seed;
-    }
+    seed(args.seed, scene)?;
     if let Some(e) = args.epsilon {
         check(
             e.is_finite() && e >= 0.0,
@@ -390,9 +403,7 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
     let mut scene = load(args.scene.as_deref())?;
     density(args.samples, args.spacing, args.max_samples, &mut scene)?;
     threads(args.threads, &mut scene)?;
-    if let Some(seed) = args.seed {
-        scene.render.seed = seed;
-    }
+    seed(args.seed, &mut scene)?;
     if let Some(method) = args.method {
         scene.render.method = method;
     }

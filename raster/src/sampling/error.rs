@@ -4,10 +4,10 @@ use std::fmt;
 
 use glam::Vec3;
 
-/// Most samples [`poisson_samples`](super::poisson_samples) will place. More is almost always
-/// a unit mistake (a spacing in millimetres for a scene in metres); the error says how many it
-/// would have made.
-pub const MAX_SAMPLES: u64 = 50_000_000;
+/// Most samples [`poisson_samples`](super::poisson_samples) will place: the scene's limit
+/// ([`crate::scene::MAX_SAMPLES`], 2²⁵). More is almost always a unit mistake (a spacing in
+/// millimetres for a scene in metres); the error says how many it would have made.
+pub const MAX_SAMPLES: u64 = crate::scene::MAX_SAMPLES as u64;
 
 /// Why samples could not be placed.
 #[derive(Clone, Debug, PartialEq)]
@@ -94,11 +94,19 @@ impl fmt::Display for SamplingError {
                 count,
                 spacing: Some(spacing),
                 total_area,
-            } => write!(
-                f,
-                "sample spacing {spacing} over a total area of {total_area} would make {count} \
-                 samples, more than the limit of {MAX_SAMPLES}; check the scene's units"
-            ),
+            } => {
+                // The count saturates at u64::MAX for absurd spacings: say so, not 18446….
+                let count = match *count {
+                    u64::MAX => "more than 10¹⁹".to_string(),
+                    n => n.to_string(),
+                };
+                write!(
+                    f,
+                    "sample spacing {spacing} over a total area of {total_area} would make \
+                     {count} samples, more than the limit of {MAX_SAMPLES}; check the scene's \
+                     units"
+                )
+            }
             SamplingError::TooManySamples { count, .. } => write!(
                 f,
                 "{count} samples asked for, more than the limit of {MAX_SAMPLES}"

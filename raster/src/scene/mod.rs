@@ -47,4 +47,6 @@ pub use materials::preset_names;
 pub use model::*;
 pub use objects::SHAPES;
 pub use origin::{MAX_FILE_BYTES, SceneOrigin, files_read};
-pub use settings::{AUTO, DEFAULT_RESOLUTION, LAYERS, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE};
+pub use settings::{
+    AUTO, DEFAULT_RESOLUTION, LAYERS, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_THREADS,
+};

@@ -26,6 +26,9 @@ pub const MAX_PIXELS: i64 = 1 << 26;
 /// Largest number of irradiance samples a scene may ask for (directly or through `spacing`).
 pub const MAX_SAMPLES: i64 = 1 << 25;
 
+/// Most worker threads a render may ask for (`threads`, `--threads`).
+pub const MAX_THREADS: i64 = 1024;
+
 /// The word that asks for an automatic sample count (`samples = "auto"`, `--samples auto`).
 pub const AUTO: &str = "auto";
 
@@ -218,7 +221,7 @@ pub(crate) fn build_render(
         )?;
     }
     if let Some(v) = &r.threads {
-        s.threads = Some(c.int("render.threads", v, 1, 1024)? as usize);
+        s.threads = Some(c.int("render.threads", v, 1, MAX_THREADS)? as usize);
     }
     if let Some(v) = &r.seed {
         s.seed = c.int("render.seed", v, 0, i64::MAX)? as u64;

@@ -103,7 +103,24 @@ fn zero_and_huge_resolution_flags() {
         (&["--aa", "0"], &["--aa 0", "between 1 and 8"]),
         (&["--aa", "9"], &["--aa 9"]),
         (&["--threads", "0"], &["--threads 0"]),
+        // The scene's own limits: `threads` in 1..=1024, `seed` a signed 64-bit integer.
+        (
+            &["--threads", "1025"],
+            &["--threads 1025", "between 1 and 1024"],
+        ),
+        (
+            &["--seed", "9223372036854775808"],
+            &[
+                "--seed 9223372036854775808",
+                "between 0 and 9223372036854775807",
+            ],
+        ),
         (&["--spacing", "0"], &["--spacing 0", "positive"]),
+        // A count that saturates is not printed as 18446744073709551615.
+        (
+            &["--spacing", "1e-45"],
+            &["would make more than 10¹⁹ samples", "the limit of 33554432"],
+        ),
         (&["--exposure", "65"], &["--exposure 65"]),
         (
             &["--interpolation", "0"],
