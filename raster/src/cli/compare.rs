@@ -11,9 +11,9 @@ use super::CompareArgs;
 use super::commands::check_outputs;
 use crate::output::image::{LAYER_EXITANCE, LAYER_IRRADIANCE};
 use crate::output::{
-    ErrorMetric, ErrorStats, HeatmapOptions, HeatmapScale, LayerData, RgbImage,
-    compare as compare_images, default_band_radius, error_heatmap, read_exr, read_png, seed_noise,
-    shadow_edge_band, translucent_mask,
+    ErrorMetric, ErrorStats, Frame, HeatmapOptions, HeatmapScale, LayerData, RgbImage,
+    compare as compare_images, default_band_radius, error_heatmap, read_exr_framed, read_png,
+    seed_noise, shadow_edge_band, translucent_mask,
 };
 
 /// An image and, for EXR files, the layers the regions are found from.
@@ -21,6 +21,8 @@ struct Loaded {
     image: RgbImage,
     exitance: Option<Vec<glam::Vec3>>,
     irradiance: Option<Vec<glam::Vec3>>,
+    /// An EXR's display and data windows: two files must cover the same region.
+    frame: Option<Frame>,
 }
 
 fn read(path: &Path) -> Result<Loaded, String> {
@@ -34,9 +36,10 @@ fn read(path: &Path) -> Result<Loaded, String> {
             image: read_png(path).map_err(|e| e.to_string())?,
             exitance: None,
             irradiance: None,
+            frame: None,
         }),
         "exr" => {
-            let exr = read_exr(path).map_err(|e| e.to_string())?;
+            let (exr, frame) = read_exr_framed(path).map_err(|e| e.to_string())?;
             let layer = |name: &str| {
                 exr.layers.iter().find_map(|l| match &l.data {
                     LayerData::Rgb(p) if l.name == name => Some(p.clone()),
@@ -47,6 +50,7 @@ fn read(path: &Path) -> Result<Loaded, String> {
                 exitance: layer(LAYER_EXITANCE),
                 irradiance: layer(LAYER_IRRADIANCE),
                 image: exr.beauty,
+                frame: Some(frame),
             })
         }
         _ => Err(format!(
@@ -54,6 +58,32 @@ fn read(path: &Path) -> Result<Loaded, String> {
             path.display()
         )),
     }
+}
+
+/// Two EXR files must hold the same pixels of the same image: tiles of one size from
+/// different places (`render --crop`) compare pixels that have nothing to do with each other.
+fn same_region(test: &Loaded, reference: &Loaded, args: &CompareArgs) -> Result<(), String> {
+    let (Some(t), Some(r)) = (test.frame, reference.frame) else {
+        return Ok(());
+    };
+    let describe = |f: Frame| {
+        format!(
+            "pixels from ({}, {}) of a {}×{} image",
+            f.data_origin.0, f.data_origin.1, f.display_size.0, f.display_size.1
+        )
+    };
+    if (t.display_origin, t.display_size, t.data_origin)
+        != (r.display_origin, r.display_size, r.data_origin)
+    {
+        return Err(format!(
+            "{} holds {}, {} holds {}: compare images of the same region",
+            args.test.display(),
+            describe(t),
+            args.reference.display(),
+            describe(r)
+        ));
+    }
+    Ok(())
 }
 
 /// The rows printed for one region.
@@ -81,6 +111,7 @@ pub fn compare(args: &CompareArgs) -> Result<(), String> {
     }
     let test = read(&args.test)?;
     let reference = read(&args.reference)?;
+    same_region(&test, &reference, args)?;
     let (width, height) = reference.image.size();
     let whole = compare_images(&test.image, &reference.image, None).map_err(|e| e.to_string())?;
     outln!(

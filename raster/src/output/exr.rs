@@ -263,9 +263,10 @@ struct Channel {
 
 /// Where a decoded file's pixels lie (see [`read_exr_framed`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Frame {
-    /// The display window's position and size.
+pub struct Frame {
+    /// The display window's position.
     pub display_origin: (i32, i32),
+    /// The display window's size.
     pub display_size: (u64, u64),
     /// The data window's position (of the part holding `R`, `G`, `B`).
     pub data_origin: (i32, i32),
@@ -431,7 +432,7 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, OutputError> {
 
 /// [`read_exr`], also returning the display and data windows and the exposure attribute.
 /// Layers and alpha whose data window differs from the beauty image's are an error.
-pub(super) fn read_exr_framed(path: &Path) -> Result<(ExrImage, Frame), OutputError> {
+pub fn read_exr_framed(path: &Path) -> Result<(ExrImage, Frame), OutputError> {
     let (channels, frame) = load_channels(path)?;
     let beauty = beauty(path, &channels)?;
     let misplaced = |name: &str, origin: (i32, i32)| {

@@ -46,7 +46,7 @@ pub use atomic::{
 #[cfg(feature = "harness")]
 pub use compare::{ErrorStats, RELATIVE_L1_OFFSET, compare};
 pub use error::OutputError;
-pub use exr::{ExrImage, read_exr, read_exr_rgb, write_exr};
+pub use exr::{ExrImage, Frame, read_exr, read_exr_framed, read_exr_rgb, write_exr};
 #[cfg(feature = "harness")]
 pub use heatmap::{ErrorMetric, Heatmap, HeatmapOptions, HeatmapScale, error_heatmap};
 pub use image::{Layer, LayerData, RgbImage};

@@ -106,8 +106,8 @@ fn unwritable_bake_output() {
     );
 }
 
-/// `compare` on missing, truncated and non-image files, and of different sizes: an error
-/// naming the file, and no heat map written.
+/// `compare` on missing, truncated and non-image files, of different sizes, and on tiles of
+/// different places: an error naming the file, and no heat map written.
 #[cfg(feature = "harness")]
 #[test]
 fn compare_bad_images() {
@@ -125,6 +125,10 @@ fn compare_bad_images() {
     );
     small.succeeds(&render(&[]));
     sb.write("small.png", &small.read("out.png"));
+    // Two tiles of one size from different places of the image.
+    for (crop, name) in [("0,0,32,16", "top.exr"), ("0,16,32,32", "bottom.exr")] {
+        sb.succeeds(&render(&["--aa", "1", "--crop", crop, "--exr", name]));
+    }
     let heat = ["--heatmap", "heat.png"];
     let cases: &[(&[&str], &[&str])] = &[
         (&["compare", "a.png", "nosuch.png"], &["nosuch.png"]),
@@ -135,6 +139,14 @@ fn compare_bad_images() {
             &["scene.toml", "unknown image type"],
         ),
         (&["compare", "a.png", "small.png"], &["32", "16"]),
+        (
+            &["compare", "top.exr", "bottom.exr"],
+            &[
+                "top.exr holds pixels from (0, 0) of a 32×32 image",
+                "bottom.exr holds pixels from (0, 16)",
+                "compare images of the same region",
+            ],
+        ),
     ];
     for (args, needles) in cases {
         let mut all = args.to_vec();
