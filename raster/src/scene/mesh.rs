@@ -158,18 +158,30 @@ pub fn finish_loaded_mesh(mut mesh: Mesh, normals: Option<Vec<Vec3>>) -> Result<
     mesh.normals = normals.unwrap_or_default();
     drop_unused_vertices(&mut mesh);
     // File normals are only trusted when every vertex has a usable one.
-    let usable = mesh.normals.len() == mesh.positions.len()
-        && mesh
-            .normals
-            .iter()
-            .all(|n| n.is_finite() && n.length() > 1e-12);
-    mesh.normals = if usable {
-        mesh.normals.iter().map(|n| n.normalize()).collect()
-    } else {
-        smooth_normals(&mesh.positions, &mesh.triangles)
+    let units: Option<Vec<Vec3>> = (mesh.normals.len() == mesh.positions.len())
+        .then(|| mesh.normals.iter().map(|&n| unit_normal(n)).collect())
+        .flatten();
+    mesh.normals = match units {
+        Some(units) => units,
+        None => smooth_normals(&mesh.positions, &mesh.triangles),
     };
     validate_mesh(&mesh)?;
     Ok(mesh)
+}
+
+/// A file's normal as a unit vector, or `None` when it has no direction (length below 10⁻¹²,
+/// or not finite). A length beyond f32 (`vn 3e38 3e38 0`) is scaled by the largest component
+/// first: normalised directly, it gave the zero vector.
+pub fn unit_normal(n: Vec3) -> Option<Vec3> {
+    if !n.is_finite() {
+        return None;
+    }
+    let length = n.length();
+    if length.is_finite() {
+        (length > 1e-12).then(|| n.normalize())
+    } else {
+        Some((n / n.abs().max_element()).normalize())
+    }
 }
 
 /// A loaded mesh's positions and UVs must be finite (vertex numbers 1-based, as in files).

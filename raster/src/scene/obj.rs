@@ -17,7 +17,9 @@ use std::io::BufReader;
 
 use glam::{Vec2, Vec3};
 
-use super::mesh::{drop_unused_vertices, reject_non_finite, smooth_normals, validate_mesh};
+use super::mesh::{
+    drop_unused_vertices, reject_non_finite, smooth_normals, unit_normal, validate_mesh,
+};
 use super::model::Mesh;
 use super::sanity::{normals_against_winding, orient_outward};
 
@@ -264,12 +266,12 @@ fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh
     reject_non_finite(&mesh).map_err(fail)?;
     drop_unused_vertices(&mut mesh);
     // File normals are only trusted when every vertex has a usable one.
-    let usable = all_normals
-        && normals.len() == mesh.positions.len()
-        && normals.iter().all(|n| n.is_finite() && n.length() > 1e-12);
+    let units: Option<Vec<Vec3>> = (all_normals && normals.len() == mesh.positions.len())
+        .then(|| normals.into_iter().map(unit_normal).collect())
+        .flatten();
     let mut warnings = Vec::new();
-    if usable {
-        mesh.normals = normals.into_iter().map(Vec3::normalize).collect();
+    if let Some(units) = units {
+        mesh.normals = units;
         warnings.extend(orient_outward(&mut mesh, true));
         warnings.extend(normals_against_winding(&mesh));
     } else {
@@ -381,6 +383,21 @@ f 1/1 2/2 3/3 4/4
         let m = parse_obj(text.as_bytes()).expect("loads");
         assert_eq!(m.normals, vec![Vec3::Z; 3]);
         assert!(m.uvs.is_none());
+        // A length beyond f32 keeps its direction (it was normalised to zero and refused);
+        // below 10⁻¹² a normal has none, and the triangle's own (+z) is computed instead.
+        let lengths = [
+            ("vn 3e38 0 3e38", Vec3::new(1.0, 0.0, 1.0).normalize()),
+            ("vn 1e-30 0 1e-30", Vec3::Z),
+        ];
+        for (vn, want) in lengths {
+            let text = format!("v 0 0 0\nv 1 0 0\nv 0 1 0\n{vn}\nf 1//1 2//1 3//1\n");
+            let m = parse_obj(text.as_bytes()).expect("loads");
+            assert!(
+                m.normals.iter().all(|n| (*n - want).length() < 1e-6),
+                "{vn}: {:?}",
+                m.normals
+            );
+        }
     }
 
     #[test]
