@@ -43,8 +43,10 @@ fn golden(name: &str) -> PathBuf {
     root().join("tests/golden").join(name)
 }
 
+/// `LUCENT_BLESS=1` regenerates the goldens; unset, empty or `0` compares with them (an empty
+/// value once blessed a changed golden unnoticed).
 fn bless() -> bool {
-    std::env::var_os("LUCENT_BLESS").is_some_and(|v| v != "0")
+    std::env::var_os("LUCENT_BLESS").is_some_and(|v| !v.is_empty() && v != "0")
 }
 
 /// The golden scenes, small: a few thousand samples, 64–96 pixels.

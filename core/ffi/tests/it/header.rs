@@ -15,7 +15,7 @@ fn header_is_current() {
     let mut generated = Vec::new();
     bindings.write(&mut generated);
     let path = crate_dir.join("include/lucent.h");
-    if std::env::var_os("LUCENT_BLESS").is_some_and(|v| v != "0") {
+    if std::env::var_os("LUCENT_BLESS").is_some_and(|v| !v.is_empty() && v != "0") {
         std::fs::write(&path, &generated).unwrap();
         return;
     }

@@ -25,7 +25,7 @@ fn scenes_dir() -> PathBuf {
 }
 
 fn bless() -> bool {
-    std::env::var_os("LUCENT_BLESS").is_some_and(|v| v != "0")
+    std::env::var_os("LUCENT_BLESS").is_some_and(|v| !v.is_empty() && v != "0")
 }
 
 /// K_d as 8-bit sRGB codes at texel (x, y), y from the top: a 4 × 4 checker of a warm
