@@ -27,6 +27,7 @@ pub mod cli;
 pub mod geometry;
 pub mod lights;
 pub mod material;
+pub mod memory;
 pub mod output;
 #[cfg(feature = "harness")]
 pub mod plot;

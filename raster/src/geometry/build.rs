@@ -15,6 +15,8 @@
 
 use glam::Vec3;
 
+use crate::memory::{self, OutOfMemory};
+
 use super::aabb::Aabb;
 use super::node::{BvhNode, WideNode};
 
@@ -63,11 +65,11 @@ struct Task {
 }
 
 /// Builds the tree over `triangles` (only the first [`MAX_TRIANGLES`] are looked at).
-pub(super) fn build(triangles: &[[Vec3; 3]]) -> Built {
+pub(super) fn build(triangles: &[[Vec3; 3]]) -> Result<Built, OutOfMemory> {
     let triangles = &triangles[..triangles.len().min(MAX_TRIANGLES)];
-    let mut boxes = Vec::with_capacity(triangles.len());
-    let mut centroids = Vec::with_capacity(triangles.len());
-    let mut order = Vec::with_capacity(triangles.len());
+    let mut boxes = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
+    let mut centroids = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
+    let mut order = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
     let mut skipped = Vec::new();
     for (i, t) in triangles.iter().enumerate() {
         let b = Aabb::from_triangle(t);
@@ -79,15 +81,14 @@ pub(super) fn build(triangles: &[[Vec3; 3]]) -> Built {
             skipped.push(i as u32);
         }
     }
-    let mut nodes = Vec::new();
     if order.is_empty() {
-        return Built {
-            nodes,
+        return Ok(Built {
+            nodes: Vec::new(),
             order,
             skipped,
-        };
+        });
     }
-    nodes.reserve(2 * order.len() - 1);
+    let mut nodes = memory::with_capacity(2 * order.len() - 1, memory::TRIANGLES)?;
     nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
     let mut stack = vec![Task {
         node: 0,
@@ -128,11 +129,11 @@ pub(super) fn build(triangles: &[[Vec3; 3]]) -> Built {
             depth: task.depth + 1,
         });
     }
-    Built {
+    Ok(Built {
         nodes,
         order,
         skipped,
-    }
+    })
 }
 
 /// Per-triangle data the builder reads.
@@ -274,16 +275,15 @@ impl Builder<'_> {
 /// them saves the most visits. Leaves are the binary tree's leaves, unchanged. Lanes keep the
 /// binary tree's left-to-right order; the children of one wide node get consecutive indices.
 /// Deterministic, O(N).
-pub(super) fn collapse(nodes: &[BvhNode]) -> Vec<WideNode> {
-    let mut wide = Vec::new();
+pub(super) fn collapse(nodes: &[BvhNode]) -> Result<Vec<WideNode>, OutOfMemory> {
     let Some(root) = nodes.first() else {
-        return wide;
+        return Ok(Vec::new());
     };
-    wide.reserve(nodes.len() / 3 + 1);
+    let mut wide = memory::with_capacity(nodes.len() / 3 + 1, memory::TRIANGLES)?;
     wide.push(WideNode::EMPTY);
     if root.is_leaf() {
         wide[0].set_lane(0, &root.bounds(), root.first, root.count as u8);
-        return wide;
+        return Ok(wide);
     }
     let mut stack = vec![(0u32, 0u32)];
     while let Some((binary, index)) = stack.pop() {
@@ -323,7 +323,7 @@ pub(super) fn collapse(nodes: &[BvhNode]) -> Vec<WideNode> {
         }
         wide[index as usize] = node;
     }
-    wide
+    Ok(wide)
 }
 
 /// The most entries the traversal stack of `Bvh`'s queries can hold on `wide`: a visit to a

@@ -29,6 +29,7 @@ use super::aabb::{Aabb, RayLanes};
 use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES, SMALL_STACK, WIDE_STACK};
 use super::node::{BvhNode, WideNode};
 use super::ray::{Hit, Ray};
+use crate::memory::{self, OutOfMemory};
 
 /// Box tests accept boxes entered up to this factor beyond the query's limit (`t_max`, or the
 /// best hit so far). The slab test is conservative for the exact ray, but the triangle test's
@@ -126,11 +127,22 @@ impl Bvh {
     /// Builds the BVH (binned SAH; see the `build` module). Triangles with a non-finite
     /// coordinate are left out (see [`Bvh::skipped`]); zero-area ones are kept and never hit.
     /// Deterministic, O(N log N). Only the first 2³¹ triangles are used.
+    ///
+    /// Panics if memory runs out; [`Bvh::try_build`] reports that instead.
     pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
-        let built = build::build(triangles);
-        let tris = built.order.iter().map(|&i| triangles[i as usize]).collect();
-        let wide = build::collapse(&built.nodes);
-        Bvh {
+        Self::try_build(triangles).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`Bvh::build`], or [`OutOfMemory`] if the allocator refuses one of its buffers.
+    pub fn try_build(triangles: &[[Vec3; 3]]) -> Result<Bvh, OutOfMemory> {
+        let built = build::build(triangles)?;
+        let tris = memory::collect(
+            built.order.len(),
+            built.order.iter().map(|&i| triangles[i as usize]),
+            memory::TRIANGLES,
+        )?;
+        let wide = build::collapse(&built.nodes)?;
+        Ok(Bvh {
             stack_need: build::stack_need(&wide) as u32,
             wide,
             nodes: built.nodes,
@@ -138,7 +150,7 @@ impl Bvh {
             ids: built.order,
             skipped: built.skipped,
             source_len: triangles.len().min(MAX_TRIANGLES) as u32,
-        }
+        })
     }
 
     /// Number of triangles in the BVH (input triangles less the skipped ones).

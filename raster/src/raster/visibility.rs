@@ -62,7 +62,8 @@ impl fmt::Display for RasterError {
             Self::TooLarge { width, height, aa } => write!(
                 f,
                 "visibility buffer of {width}×{height} pixels with aa = {aa} exceeds \
-                 {MAX_GRID_AXIS} sub-samples per axis or {MAX_SUBSAMPLES} in total"
+                 {MAX_GRID_AXIS} sub-samples per axis or {MAX_SUBSAMPLES} in total (lower the \
+                 resolution or the antialiasing: 'aa' in [render], or --aa)"
             ),
             Self::OutOfMemory { bytes } => {
                 write!(

@@ -29,6 +29,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
+use crate::memory::{self, OutOfMemory};
 use crate::scene::Mesh;
 
 /// Relative tolerance (of the bounding-box diagonal) for "behind or on a plane".
@@ -62,8 +63,14 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> bool {
     if !diagonal.is_finite() {
         return false;
     }
-    let planes = face_planes(mesh, origin, diagonal);
-    let vertices = referenced_vertices(mesh, origin);
+    // A mesh whose test does not fit in memory is taken to shadow itself, like one whose test
+    // exceeds the work limit.
+    let Ok(planes) = face_planes(mesh, origin, diagonal) else {
+        return false;
+    };
+    let Ok(vertices) = referenced_vertices(mesh, origin) else {
+        return false;
+    };
     let tolerance = TOLERANCE * diagonal;
     let Some(widest) = planes.iter().max_by(|a, b| a.area.total_cmp(&b.area)) else {
         return true; // no face with a plane: nothing a ray could hit but lines and points
@@ -74,7 +81,9 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> bool {
     {
         return true; // flat
     }
-    let tree = VertexTree::build(vertices);
+    let Ok(tree) = VertexTree::build(vertices) else {
+        return false;
+    };
     // Faces in parallel. The answer does not depend on the order: true needs every face to
     // pass, and then the total work is the same sum whatever the order.
     let work = AtomicU64::new(0);
@@ -117,32 +126,32 @@ impl Plane {
 
 /// The planes of the faces whose corners are pairwise farther apart than [`DEGENERATE`] of
 /// the diagonal and whose normal is non-zero.
-fn face_planes(mesh: &Mesh, origin: DVec3, diagonal: f64) -> Vec<Plane> {
+fn face_planes(mesh: &Mesh, origin: DVec3, diagonal: f64) -> Result<Vec<Plane>, OutOfMemory> {
     let apart = DEGENERATE * diagonal;
-    mesh.triangles
-        .iter()
-        .filter_map(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
-            if a.distance(b) <= apart || b.distance(c) <= apart || a.distance(c) <= apart {
-                return None;
-            }
-            let n = (b - a).cross(c - a);
-            let area = n.length();
-            (area > 0.0 && area.is_finite()).then(|| Plane {
-                at: a - origin,
-                normal: n / area,
-                area,
-            })
+    let mut planes = memory::with_capacity(mesh.triangles.len(), memory::TRIANGLES)?;
+    planes.extend(mesh.triangles.iter().filter_map(|t| {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
+        if a.distance(b) <= apart || b.distance(c) <= apart || a.distance(c) <= apart {
+            return None;
+        }
+        let n = (b - a).cross(c - a);
+        let area = n.length();
+        (area > 0.0 && area.is_finite()).then(|| Plane {
+            at: a - origin,
+            normal: n / area,
+            area,
         })
-        .collect()
+    }));
+    Ok(planes)
 }
 
 /// The positions some triangle uses, each once, relative to `origin`, with an outward
 /// direction for each: the sum of its faces' area-weighted normals (only a hint for the
 /// orientation of [`VertexTree`]'s boxes; any direction keeps the test exact).
-fn referenced_vertices(mesh: &Mesh, origin: DVec3) -> Vec<Vertex> {
-    let mut normals = vec![DVec3::ZERO; mesh.positions.len()];
-    let mut used = vec![false; mesh.positions.len()];
+fn referenced_vertices(mesh: &Mesh, origin: DVec3) -> Result<Vec<Vertex>, OutOfMemory> {
+    let n = mesh.positions.len();
+    let mut normals = memory::filled(n, DVec3::ZERO, memory::TRIANGLES)?;
+    let mut used = memory::filled(n, false, memory::TRIANGLES)?;
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
         let n = (b - a).cross(c - a);
@@ -153,16 +162,19 @@ fn referenced_vertices(mesh: &Mesh, origin: DVec3) -> Vec<Vertex> {
             }
         }
     }
-    mesh.positions
-        .iter()
-        .zip(normals)
-        .zip(used)
-        .filter(|&(_, used)| used)
-        .map(|((p, normal), _)| Vertex {
-            at: p.as_dvec3() - origin,
-            normal,
-        })
-        .collect()
+    let mut vertices = memory::with_capacity(n, memory::TRIANGLES)?;
+    vertices.extend(
+        mesh.positions
+            .iter()
+            .zip(normals)
+            .zip(used)
+            .filter(|&(_, used)| used)
+            .map(|((p, normal), _)| Vertex {
+                at: p.as_dvec3() - origin,
+                normal,
+            }),
+    );
+    Ok(vertices)
 }
 
 /// A vertex for [`VertexTree`].
@@ -204,8 +216,9 @@ struct Node {
 }
 
 impl VertexTree {
-    fn build(mut vertices: Vec<Vertex>) -> Self {
-        let mut nodes = Vec::with_capacity(2 * vertices.len().div_ceil(LEAF) + 1);
+    fn build(mut vertices: Vec<Vertex>) -> Result<Self, OutOfMemory> {
+        let mut nodes =
+            memory::with_capacity(2 * vertices.len().div_ceil(LEAF) + 1, memory::TRIANGLES)?;
         nodes.push(Node::of(&vertices, 0, vertices.len()));
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {
@@ -228,7 +241,7 @@ impl VertexTree {
             nodes[i].children = left as u32;
             stack.extend([left, left + 1]);
         }
-        VertexTree { vertices, nodes }
+        Ok(VertexTree { vertices, nodes })
     }
 
     /// Whether no vertex lies more than `tolerance` in front of `plane` (whose corner is
@@ -354,12 +367,15 @@ mod tests {
     /// behind every face's plane.
     fn every_vertex_behind_every_face(mesh: &Mesh) -> bool {
         let (origin, diagonal) = bounds(&mesh.positions).expect("a mesh with vertices");
-        face_planes(mesh, origin, diagonal).iter().all(|f| {
-            mesh.triangles.iter().flatten().all(|&i| {
-                let p = mesh.positions[i as usize].as_dvec3() - origin;
-                f.distance(p) <= TOLERANCE * diagonal
+        face_planes(mesh, origin, diagonal)
+            .unwrap()
+            .iter()
+            .all(|f| {
+                mesh.triangles.iter().flatten().all(|&i| {
+                    let p = mesh.positions[i as usize].as_dvec3() - origin;
+                    f.distance(p) <= TOLERANCE * diagonal
+                })
             })
-        })
     }
 
     #[test]
@@ -500,7 +516,7 @@ mod tests {
                 .map(|_| [next() % n, next() % n, next() % n])
                 .collect();
             let (origin, _) = bounds(&mesh.positions).expect("vertices");
-            let tree = VertexTree::build(referenced_vertices(&mesh, origin));
+            let tree = VertexTree::build(referenced_vertices(&mesh, origin).unwrap()).unwrap();
             tree.validate();
             assert_eq!(
                 cannot_shadow_itself(&mesh),
@@ -535,8 +551,8 @@ mod tests {
     /// Box and vertex visits per face for the whole test, and whether it passed.
     fn visits_per_face(mesh: &Mesh) -> (f64, bool) {
         let (origin, diagonal) = bounds(&mesh.positions).expect("vertices");
-        let planes = face_planes(mesh, origin, diagonal);
-        let tree = VertexTree::build(referenced_vertices(mesh, origin));
+        let planes = face_planes(mesh, origin, diagonal).unwrap();
+        let tree = VertexTree::build(referenced_vertices(mesh, origin).unwrap()).unwrap();
         tree.validate();
         let (passed, visits) = planes.iter().fold((true, 0), |(all, sum), plane| {
             let (one, visits) =

@@ -6,6 +6,7 @@ use glam::Vec3;
 use lucent_core::error::{BuildError, QueryError};
 
 use crate::material::MaterialError;
+use crate::memory::OutOfMemory;
 use crate::output::OutputError;
 use crate::raster::RasterError;
 use crate::sampling::SamplingError;
@@ -44,6 +45,8 @@ pub enum RenderError {
     Image(OutputError),
     /// An internal inconsistency (a bug if it ever happens).
     Core(String),
+    /// A buffer the size of the image could not be allocated.
+    Memory(OutOfMemory),
     /// The thread pool could not be started.
     Threads(rayon::ThreadPoolBuildError),
     /// `LUCENT_SIMD` asks for a traversal path this CPU cannot run, or none at all.
@@ -66,6 +69,7 @@ impl fmt::Display for RenderError {
             RenderError::Cache(e) => write!(f, "internal error: empty irradiance cache: {e}"),
             RenderError::Image(e) => write!(f, "internal error: {e}"),
             RenderError::Core(m) => write!(f, "internal error: {m}"),
+            RenderError::Memory(e) => write!(f, "{e}"),
             RenderError::Threads(e) => write!(f, "thread pool: {e}"),
             RenderError::Simd(e) => write!(f, "{e}"),
         }
@@ -81,6 +85,7 @@ impl std::error::Error for RenderError {
             RenderError::BakedFile(e) | RenderError::Image(e) => Some(e),
             RenderError::Query { source, .. } => Some(source),
             RenderError::Cache(e) => Some(e),
+            RenderError::Memory(e) => Some(e),
             RenderError::Threads(e) => Some(e),
             RenderError::Simd(e) => Some(e),
             RenderError::Baked(_)
@@ -94,6 +99,12 @@ impl std::error::Error for RenderError {
 impl From<MaterialError> for RenderError {
     fn from(e: MaterialError) -> Self {
         RenderError::Material(e)
+    }
+}
+
+impl From<OutOfMemory> for RenderError {
+    fn from(e: OutOfMemory) -> Self {
+        RenderError::Memory(e)
     }
 }
 

@@ -52,6 +52,7 @@ pub use shading::{
 
 use crate::lights::Lighting;
 use crate::material::{MaterialError, Shader};
+use crate::memory;
 use crate::output::image::{LAYER_EXITANCE, LAYER_GLOBAL, LAYER_IRRADIANCE, LAYER_LOCAL};
 use crate::output::{Layer, Region, RgbImage};
 use crate::raster::VisibilityBuffer;
@@ -433,7 +434,11 @@ fn render_in_pool(
     let row_width = shaded.width().max(1) as usize;
     // Shaded in place, one row per task: a single buffer, touched once (fresh pages cost a
     // fault each; rows gathered into a second buffer doubled that).
-    let mut pixels = vec![PixelValue::default(); shaded.pixels() as usize];
+    let mut pixels = memory::filled(
+        shaded.pixels() as usize,
+        PixelValue::default(),
+        memory::PIXELS,
+    )?;
     let mut counters = ShadingCounters::default();
     let (mut shading_points, mut queries, mut interpolated) = (0, 0, 0);
     let (mut probes, mut probed_pixels, mut refined_pixels) = (0, 0, 0);

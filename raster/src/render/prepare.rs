@@ -7,6 +7,7 @@ use super::RenderError;
 use super::convexity::cannot_shadow_itself;
 use crate::geometry::Bvh;
 use crate::material::Shader;
+use crate::memory;
 use crate::scene::{Object, Scene};
 
 /// An object that cannot shadow itself gets a BVH without its own triangles when it holds at
@@ -53,8 +54,14 @@ impl<'s> Prepared<'s> {
                 u32::MAX - 1
             )));
         }
-        let mut triangles = Vec::with_capacity(total);
-        let mut object_of = Vec::with_capacity(total);
+        // What the triangles will need up to the placed samples, asked for at once: a scene
+        // too large for the memory granted stops here rather than aborting midway.
+        memory::probe(
+            (total as u64).saturating_mul(memory::PEAK_BYTES_PER_TRIANGLE),
+            memory::TRIANGLES,
+        )?;
+        let mut triangles = memory::with_capacity(total, memory::TRIANGLES)?;
+        let mut object_of = memory::with_capacity(total, memory::TRIANGLES)?;
         let mut first_triangle = Vec::with_capacity(scene.objects.len() + 1);
         for (i, object) in scene.objects.iter().enumerate() {
             first_triangle.push(triangles.len() as u32);
@@ -77,7 +84,8 @@ impl<'s> Prepared<'s> {
             (hi - lo).length().max(f32::MIN_POSITIVE)
         };
         let occluders = (!scene.lights.is_empty() && can_occlude(&scene.objects))
-            .then(|| Bvh::build(&triangles));
+            .then(|| Bvh::try_build(&triangles))
+            .transpose()?;
         let others = scene
             .objects
             .iter()
@@ -85,17 +93,19 @@ impl<'s> Prepared<'s> {
             .map(|(i, object)| {
                 let own = object.mesh.triangles.len();
                 let large = own > 0 && own.saturating_mul(OWN_BVH_SHARE) >= total;
-                (occluders.is_some() && large && cannot_shadow_itself(&object.mesh)).then(|| {
-                    let (a, b) = (first_triangle[i] as usize, first_triangle[i + 1] as usize);
-                    let rest: Vec<[Vec3; 3]> = triangles[..a]
-                        .iter()
-                        .chain(&triangles[b..])
-                        .copied()
-                        .collect();
-                    Bvh::build(&rest)
-                })
+                (occluders.is_some() && large && cannot_shadow_itself(&object.mesh))
+                    .then(|| {
+                        let (a, b) = (first_triangle[i] as usize, first_triangle[i + 1] as usize);
+                        let rest = memory::collect(
+                            total - (b - a),
+                            triangles[..a].iter().chain(&triangles[b..]).copied(),
+                            memory::TRIANGLES,
+                        )?;
+                        Bvh::try_build(&rest)
+                    })
+                    .transpose()
             })
-            .collect();
+            .collect::<Result<_, _>>()?;
         Ok(Prepared {
             scene,
             shaders,

@@ -14,6 +14,7 @@
 mod harness;
 
 mod flags;
+mod memory;
 mod obj;
 mod outputs;
 mod ply;

@@ -117,6 +117,8 @@ pub fn scene(object: &str, material: &str) -> String {
 pub struct Sandbox {
     dir: PathBuf,
     env: Vec<(&'static str, &'static str)>,
+    /// The binary's address-space limit in KiB (`ulimit -v`), if any.
+    address_space: Option<u64>,
 }
 
 impl Sandbox {
@@ -136,6 +138,7 @@ impl Sandbox {
         let sandbox = Sandbox {
             dir,
             env: Vec::new(),
+            address_space: None,
         };
         sandbox.write("scene.toml", text.as_bytes());
         sandbox.reset_outputs();
@@ -145,6 +148,13 @@ impl Sandbox {
     /// The sandbox, running the binary with the environment variable `key` set to `value`.
     pub fn with_env(mut self, key: &'static str, value: &'static str) -> Sandbox {
         self.env.push((key, value));
+        self
+    }
+
+    /// The sandbox, running the binary with at most `kib` KiB of address space (`ulimit -v`
+    /// through `sh`), so that large allocations fail as they would on a smaller machine.
+    pub fn with_address_space(mut self, kib: u64) -> Sandbox {
+        self.address_space = Some(kib);
         self
     }
 
@@ -197,7 +207,20 @@ impl Sandbox {
 
     /// Runs `lucent args…` in the sandbox.
     pub fn run(&self, args: &[&str]) -> Output {
-        Command::new(env!("CARGO_BIN_EXE_lucent"))
+        let binary = env!("CARGO_BIN_EXE_lucent");
+        let mut command = match self.address_space {
+            None => Command::new(binary),
+            Some(kib) => {
+                let mut sh = Command::new("sh");
+                sh.args([
+                    "-c",
+                    &format!("ulimit -v {kib} && exec \"$0\" \"$@\""),
+                    binary,
+                ]);
+                sh
+            }
+        };
+        command
             .args(args)
             .current_dir(&self.dir)
             .env_remove("RAYON_NUM_THREADS")

@@ -1,0 +1,72 @@
+//! Scenes and images larger than the memory granted: an error naming the buffer, its size and
+//! what makes it smaller, never an abort. The binary runs under an address-space limit
+//! (`ulimit -v`), which makes the allocator refuse what a smaller machine would.
+
+use super::harness::{CONSTANT, Sandbox, scene};
+
+/// 1.5 GiB of address space: the binary, its threads and a small scene fit.
+const LIMIT_KIB: u64 = 3 << 19;
+
+/// 16384 × 4096 pixels need 4.3 GiB for the shaded pixels alone; the visibility buffer
+/// (8 bytes per pixel at aa 1) still fits, so the refusal comes from the pixel buffer.
+#[test]
+#[cfg(target_os = "linux")]
+fn an_image_larger_than_memory_is_an_error() {
+    let text = scene("shape = \"sphere\"\nradius = 0.5\nsegments = 24", CONSTANT)
+        .replace("width = 32", "width = 16384")
+        .replace("height = 32", "height = 4096")
+        .replace("aa = 2", "aa = 1");
+    let sb = Sandbox::with_scene("memory-image", &text).with_address_space(LIMIT_KIB);
+    sb.fails(
+        &["scene.toml"],
+        1,
+        &[
+            "out of memory: could not allocate ",
+            "GiB for the shaded pixels (lower the resolution or the antialiasing",
+        ],
+    );
+}
+
+/// A sphere of 2048 segments has 4.2 M triangles: its mesh fits, but what its triangles need
+/// up to the placed samples (320 bytes each, 1.25 GiB) does not, so the render stops before
+/// flattening them.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_scene_larger_than_memory_is_an_error() {
+    let text = scene(
+        "shape = \"sphere\"\nradius = 0.5\nsegments = 2048",
+        CONSTANT,
+    );
+    let sb = Sandbox::with_scene("memory-mesh", &text).with_address_space(LIMIT_KIB / 2);
+    sb.fails(
+        &["scene.toml"],
+        1,
+        &[
+            "out of memory: could not allocate 1.2 GiB for the scene's triangles (use fewer \
+             triangles",
+        ],
+    );
+}
+
+/// More sub-samples than the visibility buffer addresses (2²⁸): refused before anything is
+/// allocated, naming both ways to lower it.
+#[test]
+fn too_many_sub_samples_name_the_antialiasing() {
+    let sb = Sandbox::new("memory-aa");
+    sb.fails(
+        &[
+            "scene.toml",
+            "--width",
+            "16384",
+            "--height",
+            "4096",
+            "--aa",
+            "3",
+        ],
+        1,
+        &[
+            "visibility buffer of 16384×4096 pixels with aa = 3 exceeds",
+            "lower the resolution or the antialiasing: 'aa' in [render], or --aa",
+        ],
+    );
+}
