@@ -61,6 +61,7 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 pub fn parse_scene(text: &str, origin: &SceneOrigin) -> Result<Scene, SceneError> {
     let name = origin.display_name();
     let src = Source { file: &name, text };
+    super::tables::check_tables(text, &src)?;
     let deserializer = toml::de::Deserializer::parse(text).map_err(|e| src.syntax_error(&e))?;
     let raw = RawScene::deserialize(deserializer)
         .map_err(|e| src.data_error(&e, &["object", "light"]))?;

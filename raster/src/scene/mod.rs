@@ -34,6 +34,7 @@ pub mod ply;
 pub mod sanity;
 mod settings;
 pub mod shapes;
+mod tables;
 pub mod weld;
 
 #[cfg(test)]

@@ -184,6 +184,23 @@ fn malformed_scene() {
             "eta = 0.7",
             &["scene.toml:", "material.m.eta", "0.7"],
         ),
+        (
+            "a table as an array",
+            "[camera]\nposition = [0.0, -5.0, 1.2]\ntarget = [0.0, 0.0, 0.5]\nup = [0.0, 0.0, 1.0]\n\
+             fov = 35.0\nwidth = 32\nheight = 32",
+            "camera = [[0.0, -5.0, 1.2], [0.0, 0.0, 0.5], [0.0, 0.0, 1.0], 35.0, 32, 32]",
+            &["scene.toml:2:10: camera: expected a table ([camera] or { … }), got an array"],
+        ),
+        (
+            "an inline table as an array",
+            "specular = { exponent = 60.0, strength = 0.4 }",
+            "specular = [60.0, 0.4]",
+            &[
+                "scene.toml:",
+                "material.m.specular: expected a table",
+                "got an array",
+            ],
+        ),
     ];
     for (what, from, to, needles) in cases {
         assert!(base.contains(from), "{what}: template lacks {from}");
