@@ -29,6 +29,12 @@ pub const TRIANGLES: Buffer = Buffer {
     remedy: "use fewer triangles: coarser meshes or fewer segments",
 };
 
+/// The images a render writes (PNG, EXR and its layers).
+pub const OUTPUTS: Buffer = Buffer {
+    what: "the output images",
+    remedy: "lower the resolution, or write fewer EXR layers",
+};
+
 /// Peak bytes per triangle from the flattened scene to the placed samples: the shadow BVHs,
 /// the sampler's tiles and the samples' cells. Measured (peak resident set of a sphere of
 /// 4096 segments, 16.8 M triangles, and of 1024 segments, 1 M triangles): 296 and 306 bytes,

@@ -10,13 +10,14 @@ use super::BenchArgs;
 use super::{BakeArgs, RenderArgs, SamplesArg};
 #[cfg(feature = "harness")]
 use crate::bench::{self, BenchConfig, BenchScene};
+use crate::memory;
 use crate::output::{
     Placement, Region, output_target, refuse_read_only, write_exr, write_exr_tile, write_png,
 };
 use crate::render::{self, RenderOptions, read_baked, write_baked};
 use crate::scene::{
-    MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_THREADS, SampleDensity,
-    SampleRequest, Scene, default_scene, files_read, load_scene,
+    MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_THREADS, OutputSettings,
+    SampleDensity, SampleRequest, Scene, default_scene, files_read, load_scene,
 };
 
 /// Loads the scene named on the command line, or the built-in default, printing its
@@ -300,6 +301,27 @@ fn refuse_non_finite(result: &render::Render) -> Result<(), String> {
     ))
 }
 
+/// What writing a render's outputs asks for at once, in bytes, for `pixels` pixels. The PNG
+/// (8-bit copy and its compressed stream, about 6 bytes per pixel) is written and freed before
+/// the EXR, whose alpha and layers are gathered from the pixels and then, like the beauty
+/// image, copied channel by channel for the encoder.
+fn output_bytes(pixels: usize, output: &OutputSettings) -> u64 {
+    let n = pixels as u64;
+    let png = if output.png.is_some() { 6 * n } else { 0 };
+    let exr = if output.exr.is_some() {
+        let l = &output.layers;
+        let rgb_layers = [l.exitance, l.local, l.global, l.irradiance]
+            .into_iter()
+            .filter(|&on| on)
+            .count() as u64;
+        let gathered = 4 + 12 * rgb_layers + 4 * u64::from(l.depth);
+        (12 + 2 * gathered) * n
+    } else {
+        0
+    };
+    png.max(exr)
+}
+
 /// `lucent render`.
 pub fn render(args: &RenderArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
@@ -331,6 +353,11 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
     };
     let result = render::render(&scene, &options).map_err(|e| e.to_string())?;
     refuse_non_finite(&result)?;
+    memory::probe(
+        output_bytes(result.pixels.len(), &scene.output),
+        memory::OUTPUTS,
+    )
+    .map_err(|e| e.to_string())?;
 
     let mut written: Vec<String> = Vec::new();
     if let Some(png) = &scene.output.png {

@@ -70,3 +70,29 @@ fn too_many_sub_samples_name_the_antialiasing() {
         ],
     );
 }
+
+/// A render that fits but whose outputs do not: 2048 × 4096 pixels with every EXR layer ask
+/// for 124 bytes per pixel (992 MiB) on top of the render's own buffers; nothing is written.
+#[test]
+#[cfg(target_os = "linux")]
+fn outputs_larger_than_memory_are_an_error() {
+    let text = scene("shape = \"sphere\"\nradius = 0.5\nsegments = 24", CONSTANT)
+        .replace("width = 32", "width = 2048")
+        .replace("height = 32", "height = 4096")
+        // The objects a few hundred pixels across: the render stays quick.
+        .replace("fov = 35.0", "fov = 170.0")
+        .replace("aa = 2", "aa = 1")
+        .replace(
+            "layers = [\"exitance\"]",
+            "layers = [\"exitance\", \"local\", \"global\", \"irradiance\", \"depth\"]",
+        );
+    let sb = Sandbox::with_scene("memory-outputs", &text).with_address_space(LIMIT_KIB);
+    sb.fails(
+        &["scene.toml"],
+        1,
+        &[
+            "out of memory: could not allocate 992.0 MiB for the output images (lower the \
+             resolution, or write fewer EXR layers",
+        ],
+    );
+}
