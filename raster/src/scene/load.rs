@@ -61,10 +61,14 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 pub fn parse_scene(text: &str, origin: &SceneOrigin) -> Result<Scene, SceneError> {
     let name = origin.display_name();
     let src = Source { file: &name, text };
-    super::tables::check_tables(text, &src)?;
-    let deserializer = toml::de::Deserializer::parse(text).map_err(|e| src.syntax_error(&e))?;
-    let raw = RawScene::deserialize(deserializer)
-        .map_err(|e| src.data_error(&e, &["object", "light"]))?;
+    let root = toml::de::DeTable::parse(text).map_err(|e| src.syntax_error(&e))?;
+    super::tables::check_tables(root.get_ref(), &src)?;
+    let raw = RawScene::deserialize(toml::de::Deserializer::from(root)).map_err(|mut e| {
+        // The document was parsed above: give the error its text back, as a parse from the
+        // text would have.
+        e.set_input(Some(text));
+        src.data_error(&e, &["object", "light"])
+    })?;
     build(&raw, Check { src }, origin)
 }
 
