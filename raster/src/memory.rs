@@ -1,7 +1,8 @@
-//! Fallible allocation of the buffers that grow with the image.
+//! Fallible allocation of the buffers that grow with the image or with the scene's triangles.
 //!
-//! A buffer the size of the image (the shaded pixels, the output layers) can be gigabytes at
-//! the largest sizes a scene allows. Where the allocator refuses one (an address-space limit
+//! A buffer the size of the image (the visibility buffer, the shaded pixels, the output
+//! layers) or of the scene's triangles (the shadow rays' BVHs) can be gigabytes at the largest
+//! sizes a scene allows. Where the allocator refuses one (an address-space limit
 //! such as `ulimit -v`, or a request larger than the machine's memory and swap), the render
 //! stops with an [`OutOfMemory`] error naming the buffer and its size, instead of aborting the
 //! process.
@@ -20,6 +21,12 @@ pub struct Buffer {
 /// Buffers of one element per pixel.
 pub const PIXELS: Buffer = Buffer {
     what: "the shaded pixels",
+    remedy: "lower the resolution or the antialiasing",
+};
+
+/// The depth and triangle id of every sub-sample.
+pub const VISIBILITY: Buffer = Buffer {
+    what: "the visibility buffer",
     remedy: "lower the resolution or the antialiasing",
 };
 
@@ -97,8 +104,7 @@ pub fn collect<T>(
 /// it, so it is cheap; it catches an address-space limit (`ulimit -v`) or a request beyond
 /// the machine's memory and swap, not memory that other processes take meanwhile.
 pub fn probe(bytes: u64, buffer: Buffer) -> Result<(), OutOfMemory> {
-    let refused = OutOfMemory { bytes, buffer };
-    let len = usize::try_from(bytes).map_err(|_| refused.clone())?;
+    let len = usize::try_from(bytes).map_err(|_| OutOfMemory { bytes, buffer })?;
     let v = with_capacity::<u8>(len, buffer)?;
     // Without this the optimiser may drop the allocation and its failure with it.
     std::hint::black_box(&v);

@@ -9,6 +9,7 @@ use glam::{Mat4, Vec3, Vec4};
 use super::clip::clip_and_project;
 use super::fixed::{Grid, MAX_GRID_AXIS};
 use super::scan::scan_triangle;
+use crate::memory::{self, OutOfMemory};
 
 /// The triangle id of an empty sub-sample.
 pub const EMPTY: u32 = u32::MAX;
@@ -44,10 +45,7 @@ pub enum RasterError {
         aa: u32,
     },
     /// The allocator refused the buffer.
-    OutOfMemory {
-        /// Bytes requested.
-        bytes: u64,
-    },
+    OutOfMemory(OutOfMemory),
 }
 
 impl fmt::Display for RasterError {
@@ -65,12 +63,7 @@ impl fmt::Display for RasterError {
                  {MAX_GRID_AXIS} sub-samples per axis or {MAX_SUBSAMPLES} in total (lower the \
                  resolution or the antialiasing: 'aa' in [render], or --aa)"
             ),
-            Self::OutOfMemory { bytes } => {
-                write!(
-                    f,
-                    "could not allocate {bytes} bytes for the visibility buffer"
-                )
-            }
+            Self::OutOfMemory(e) => write!(f, "{e}"),
         }
     }
 }
@@ -139,14 +132,15 @@ impl VisibilityBuffer {
             return Err(RasterError::TooLarge { width, height, aa });
         }
         let len = (cols * rows) as usize; // ≤ 2^28
-        let bytes = (cols * rows) * 8;
-        let mut depth = Vec::new();
-        let mut triangle = Vec::new();
-        if depth.try_reserve_exact(len).is_err() || triangle.try_reserve_exact(len).is_err() {
-            return Err(RasterError::OutOfMemory { bytes });
-        }
-        depth.resize(len, f32::INFINITY);
-        triangle.resize(len, EMPTY);
+        // A refusal names the whole buffer: depth and ids, 8 bytes per sub-sample.
+        let whole = |e: OutOfMemory| {
+            RasterError::OutOfMemory(OutOfMemory {
+                bytes: cols * rows * 8,
+                ..e
+            })
+        };
+        let depth = memory::filled(len, f32::INFINITY, memory::VISIBILITY).map_err(whole)?;
+        let triangle = memory::filled(len, EMPTY, memory::VISIBILITY).map_err(whole)?;
 
         // Squared distance to the pixel centre in units of (1 / 2aa)²: (2i + 1 − aa)² + (…)².
         let dist = |s: u32| {

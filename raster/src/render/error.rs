@@ -45,7 +45,7 @@ pub enum RenderError {
     Image(OutputError),
     /// An internal inconsistency (a bug if it ever happens).
     Core(String),
-    /// A buffer the size of the image could not be allocated.
+    /// A buffer that grows with the image or the scene's triangles could not be allocated.
     Memory(OutOfMemory),
     /// The thread pool could not be started.
     Threads(rayon::ThreadPoolBuildError),
