@@ -6,6 +6,8 @@ use std::path::Path;
 
 use toml::Spanned;
 
+use crate::memory;
+
 use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::RawObject;
@@ -352,6 +354,25 @@ fn build_shape(c: &Check, index: usize, raw: &Spanned<RawObject>) -> Checked<Mes
             ))
         }
     };
+    // What the shape's triangles will need up to the placed samples, asked for before the mesh
+    // is built: a mesh that does not fit would otherwise abort while it is generated.
+    let fits = |triangles: u64| -> Checked<()> {
+        let bytes = triangles.saturating_mul(memory::PEAK_BYTES_PER_TRIANGLE);
+        memory::probe(bytes, memory::TRIANGLES).map_err(|e| match &o.segments {
+            Some(v) => c.at(
+                SceneErrorKind::OutOfRange,
+                &key("segments"),
+                v,
+                e.to_string(),
+            ),
+            None => c.at(
+                SceneErrorKind::OutOfRange,
+                &key("shape"),
+                shape,
+                e.to_string(),
+            ),
+        })
+    };
     match name {
         "plane" => {
             c.forbid(&key("radius"), &o.radius, &what)?;
@@ -367,11 +388,15 @@ fn build_shape(c: &Check, index: usize, raw: &Spanned<RawObject>) -> Checked<Mes
         }
         "sphere" => {
             c.forbid(&key("size"), &o.size, &what)?;
-            Ok(shapes::sphere(radius(c)?, segments(c)?))
+            let (radius, segments) = (radius(c)?, segments(c)?);
+            fits(shapes::sphere_triangles(segments))?;
+            Ok(shapes::sphere(radius, segments))
         }
         "disk" => {
             c.forbid(&key("size"), &o.size, &what)?;
-            Ok(shapes::disk(radius(c)?, segments(c)?))
+            let (radius, segments) = (radius(c)?, segments(c)?);
+            fits(shapes::disk_triangles(segments))?;
+            Ok(shapes::disk(radius, segments))
         }
         other => Err(c.at(
             SceneErrorKind::UnknownName,

@@ -23,6 +23,19 @@ pub const MIN_SEGMENTS: u32 = 3;
 /// Largest accepted segment count (a 4096-segment sphere has 8.4 M vertices).
 pub const MAX_SEGMENTS: u32 = 4096;
 
+/// Triangles of [`sphere`] with `segments`: two per quad of the `segments × rings` grid, less
+/// the degenerate halves at the two poles.
+pub fn sphere_triangles(segments: u32) -> u64 {
+    let segments = u64::from(segments.clamp(MIN_SEGMENTS, MAX_SEGMENTS));
+    let rings = (segments / 2).max(2);
+    2 * segments * (rings - 1)
+}
+
+/// Triangles of [`disk`] with `segments`: one per segment.
+pub fn disk_triangles(segments: u32) -> u64 {
+    u64::from(segments.clamp(MIN_SEGMENTS, MAX_SEGMENTS))
+}
+
 /// A rectangle in the z = 0 plane, centred on the origin, facing +z (two triangles).
 pub fn plane(size: Vec2) -> Mesh {
     let (hx, hy) = (0.5 * size.x, 0.5 * size.y);
@@ -169,6 +182,23 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn triangle_counts_are_those_the_shapes_build() {
+        for segments in [0, 3, 4, 5, 17, 64, 5000] {
+            assert_eq!(
+                sphere(1.0, segments).triangles.len() as u64,
+                sphere_triangles(segments),
+                "sphere, {segments} segments"
+            );
+            assert_eq!(
+                disk(1.0, segments).triangles.len() as u64,
+                disk_triangles(segments),
+                "disk, {segments} segments"
+            );
+        }
+        assert_eq!(sphere_triangles(MAX_SEGMENTS), 2 * 4096 * 2047);
     }
 
     #[test]

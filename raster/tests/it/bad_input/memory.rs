@@ -27,23 +27,43 @@ fn an_image_larger_than_memory_is_an_error() {
     );
 }
 
-/// A sphere of 2048 segments has 4.2 M triangles: its mesh fits, but what its triangles need
-/// up to the placed samples (320 bytes each, 1.25 GiB) does not, so the render stops before
-/// flattening them.
+/// Four spheres of 1024 segments have 4.2 M triangles: each fits when it is built, but what
+/// their triangles need together up to the placed samples (320 bytes each, 1.25 GiB) does
+/// not, so the render stops before flattening them.
 #[test]
 #[cfg(target_os = "linux")]
 fn a_scene_larger_than_memory_is_an_error() {
-    let text = scene(
-        "shape = \"sphere\"\nradius = 0.5\nsegments = 2048",
-        CONSTANT,
-    );
+    let sphere = "shape = \"sphere\"\nradius = 0.5\nsegments = 1024\n";
+    let objects = format!("{sphere}material = \"m\"\n\n[[object]]\n").repeat(3) + sphere;
+    let text = scene(&objects, CONSTANT);
     let sb = Sandbox::with_scene("memory-mesh", &text).with_address_space(LIMIT_KIB / 2);
-    sb.fails(
+    let stderr = sb.fails(
         &["scene.toml"],
         1,
         &[
             "out of memory: could not allocate 1.2 GiB for the scene's triangles (use fewer \
              triangles",
+        ],
+    );
+    assert!(!stderr.contains("object["), "{stderr}");
+}
+
+/// A sphere of 4096 segments (16.8 M triangles) is refused before its mesh is built: the
+/// generation itself would otherwise abort the process under this limit (0.5 GiB).
+#[test]
+#[cfg(target_os = "linux")]
+fn a_shape_larger_than_memory_is_refused_before_it_is_built() {
+    let text = scene(
+        "shape = \"sphere\"\nradius = 0.5\nsegments = 4096",
+        CONSTANT,
+    );
+    let sb = Sandbox::with_scene("memory-shape", &text).with_address_space(LIMIT_KIB / 3);
+    sb.fails(
+        &["scene.toml"],
+        1,
+        &[
+            "object[0].segments: out of memory: could not allocate 5.0 GiB for the scene's \
+             triangles (use fewer triangles",
         ],
     );
 }
