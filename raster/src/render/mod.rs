@@ -26,6 +26,7 @@ mod error;
 mod interpolation;
 mod irradiance;
 mod prepare;
+mod progress;
 mod shading;
 pub mod simd;
 
@@ -33,7 +34,6 @@ use std::borrow::Cow;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use lucent_core::stats::{NoStats, QueryStats};
 use lucent_core::{IrradianceCache, QuerySettings};
 use rayon::prelude::*;
@@ -58,13 +58,14 @@ use crate::output::{Layer, Region, RgbImage};
 use crate::raster::VisibilityBuffer;
 use crate::scene::Scene;
 use interpolation::{BAND_GRID_ROWS, ExitanceGrid, Interpolation};
+use progress::bar;
 
 /// Options beyond the scene's own settings.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RenderOptions<'a> {
     /// Use these irradiance samples instead of placing and lighting new ones.
     pub baked: Option<&'a [ObjectSamples]>,
-    /// Show progress bars on stderr (only when it is a terminal).
+    /// Show progress on stderr: a bar on a terminal, a line every 10 s of a long phase elsewhere.
     pub progress: bool,
     /// Print the under-resolution warning ([`DensityPlan::warning`]) on stderr as soon as the
     /// sample count is known (it is in [`RenderStats::warning`] either way).
@@ -194,20 +195,6 @@ impl Render {
         }
         layers
     }
-}
-
-fn bar(enabled: bool, len: u64, message: &'static str) -> ProgressBar {
-    if !enabled {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:40}] {percent:>3}% {elapsed_precise}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    bar.set_message(message);
-    bar
 }
 
 fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, RenderError> {

@@ -1,0 +1,172 @@
+//! Progress of the long phases (sampling, irradiance, shading) on stderr.
+//!
+//! On a terminal, a bar redrawn in place. Anywhere else (a redirected stderr, a farm's job
+//! log) a bar's redraws would be noise, and silence until the end leaves whoever watches the
+//! log unable to tell a long render from a hung one. So there a phase that runs longer than
+//! [`LOG_INTERVAL`] writes one plain line per interval:
+//!
+//! ```text
+//! lucent: shading 45% after 0:01:23, about 0:01:41 left
+//! ```
+//!
+//! Short phases write nothing, so a typical render's stderr stays the summary line alone.
+
+use std::io::{IsTerminal, Write};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// Time between two log lines of one phase, and before its first.
+pub const LOG_INTERVAL: Duration = Duration::from_secs(10);
+
+/// How often the log's writer looks at the phase's position.
+const POLL: Duration = Duration::from_millis(200);
+
+/// A progress bar of `len` steps for the phase `message`: drawn on a terminal, logged
+/// every [`LOG_INTERVAL`] elsewhere, hidden when `enabled` is false.
+pub(crate) fn bar(enabled: bool, len: u64, message: &'static str) -> ProgressBar {
+    if !enabled {
+        return ProgressBar::hidden();
+    }
+    if !std::io::stderr().is_terminal() {
+        let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::hidden());
+        log_while_running(
+            &bar,
+            message,
+            LOG_INTERVAL,
+            Arc::new(Mutex::new(std::io::stderr())),
+        );
+        return bar;
+    }
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:40}] {percent:>3}% {elapsed_precise}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message(message);
+    bar
+}
+
+/// Writes a [`log_line`] of `bar` to `sink` every `interval` until the bar is finished or
+/// dropped, from a thread of its own (which holds the bar only while it reads it). Write
+/// errors are ignored: a closed stderr must not stop the render. If no thread can be
+/// started, the phase runs without a log.
+fn log_while_running<W: Write + Send + 'static>(
+    bar: &ProgressBar,
+    message: &'static str,
+    interval: Duration,
+    sink: Arc<Mutex<W>>,
+) {
+    let weak = bar.downgrade();
+    let _ = std::thread::Builder::new()
+        .name("progress".into())
+        .spawn(move || {
+            let mut next = interval;
+            loop {
+                std::thread::sleep(POLL.min(interval));
+                let Some(bar) = weak.upgrade() else { return };
+                if bar.is_finished() {
+                    return;
+                }
+                let elapsed = bar.elapsed();
+                if elapsed < next {
+                    continue;
+                }
+                let line = log_line(message, bar.position(), bar.length(), elapsed);
+                if let Ok(mut sink) = sink.lock() {
+                    let _ = writeln!(sink, "{line}");
+                    let _ = sink.flush();
+                }
+                next = elapsed + interval;
+            }
+        });
+}
+
+/// `lucent: PHASE P% after H:MM:SS[, about H:MM:SS left]`: the time left is extrapolated
+/// from the pace so far, once there is one.
+fn log_line(message: &str, position: u64, length: Option<u64>, elapsed: Duration) -> String {
+    let Some(length) = length.filter(|&l| l > 0) else {
+        return format!("lucent: {message} after {}", clock(elapsed));
+    };
+    let position = position.min(length);
+    let percent = position * 100 / length;
+    let mut line = format!("lucent: {message} {percent}% after {}", clock(elapsed));
+    if position > 0 && position < length {
+        let left = elapsed.as_secs_f64() * (length - position) as f64 / position as f64;
+        line.push_str(&format!(
+            ", about {} left",
+            clock(Duration::from_secs_f64(left))
+        ));
+    }
+    line
+}
+
+/// Whole seconds as `H:MM:SS`.
+fn clock(d: Duration) -> String {
+    let s = d.as_secs();
+    format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::time::Instant;
+
+    use super::*;
+
+    #[test]
+    fn a_log_line_says_the_share_done_and_the_time_left() {
+        let s = Duration::from_secs;
+        assert_eq!(
+            log_line("shading", 45, Some(100), s(83)),
+            "lucent: shading 45% after 0:01:23, about 0:01:41 left"
+        );
+        assert_eq!(
+            log_line("sampling", 0, Some(1000), s(10)),
+            "lucent: sampling 0% after 0:00:10"
+        );
+        assert_eq!(
+            log_line("irradiance", 2048, Some(1024), s(3725)),
+            "lucent: irradiance 100% after 1:02:05"
+        );
+        assert_eq!(log_line("x", 5, None, s(0)), "lucent: x after 0:00:00");
+        assert_eq!(log_line("x", 5, Some(0), s(0)), "lucent: x after 0:00:00");
+    }
+
+    /// Lines come while the phase runs, none after it is finished, and a phase finished
+    /// before its first interval writes nothing.
+    #[test]
+    fn a_running_phase_is_logged_until_it_finishes() {
+        let sink = Arc::new(Mutex::new(Vec::<u8>::new()));
+        let text = |sink: &Arc<Mutex<Vec<u8>>>| {
+            String::from_utf8(sink.lock().expect("sink").clone()).expect("utf-8")
+        };
+
+        let quick = ProgressBar::with_draw_target(Some(10), ProgressDrawTarget::hidden());
+        log_while_running(&quick, "quick", Duration::from_secs(3600), sink.clone());
+        quick.finish_and_clear();
+
+        let bar = ProgressBar::with_draw_target(Some(200), ProgressDrawTarget::hidden());
+        bar.set_position(50);
+        log_while_running(&bar, "shading", Duration::from_millis(20), sink.clone());
+        let start = Instant::now();
+        while !text(&sink).contains('\n') {
+            assert!(start.elapsed() < Duration::from_secs(30), "no line logged");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        bar.finish_and_clear();
+        // The writer sees the finish at its next look; whatever it wrote before stays.
+        std::thread::sleep(POLL * 3);
+        let logged = text(&sink);
+        std::thread::sleep(POLL * 3);
+        assert_eq!(text(&sink), logged, "lines after the phase finished");
+        assert!(!logged.contains("quick"), "{logged}");
+        for line in logged.lines() {
+            assert!(
+                line.starts_with("lucent: shading 25% after 0:00:0"),
+                "{line}"
+            );
+        }
+    }
+}
