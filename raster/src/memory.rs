@@ -42,6 +42,18 @@ pub const OUTPUTS: Buffer = Buffer {
     remedy: "lower the resolution, or write fewer EXR layers",
 };
 
+/// The whole image `lucent merge` assembles from tiles.
+pub const MERGED: Buffer = Buffer {
+    what: "the merged image",
+    remedy: "merge on a machine with more memory, or write fewer EXR layers when rendering the tiles",
+};
+
+/// The pixels of an image file being read (`lucent merge`, `lucent compare`).
+pub const READ_IMAGE: Buffer = Buffer {
+    what: "the image's pixels",
+    remedy: "read it on a machine with more memory",
+};
+
 /// Peak bytes per triangle from the flattened scene to the placed samples: the shadow BVHs,
 /// the sampler's tiles and the samples' cells. Measured (peak resident set of a sphere of
 /// 4096 segments, 16.8 M triangles, and of 1024 segments, 1 M triangles): 296 and 306 bytes,

@@ -4,7 +4,10 @@ use std::path::PathBuf;
 
 use super::MergeArgs;
 use super::commands::check_outputs;
-use crate::output::{ExrTile, merge_tiles, read_exr_tile, write_exr, write_png};
+use crate::memory;
+use crate::output::{
+    ExrImage, ExrTile, LayerData, merge_tiles, read_exr_tile, write_exr, write_png,
+};
 
 /// `lucent merge`.
 pub fn merge(args: &MergeArgs) -> Result<(), String> {
@@ -52,6 +55,7 @@ pub fn merge(args: &MergeArgs) -> Result<(), String> {
         }
         (None, None) => 0.0,
     };
+    memory::probe(encoder_bytes(image, args), memory::MERGED).map_err(|e| e.to_string())?;
     let mut written = Vec::new();
     if let Some(png) = &args.output {
         write_png(png, &image.beauty, exposure).map_err(|e| e.to_string())?;
@@ -72,4 +76,26 @@ pub fn merge(args: &MergeArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// What writing the merged image asks for at once, in bytes: the PNG's 8-bit copy and stream
+/// (about 6 bytes per pixel), or the EXR encoder's copy of every channel.
+fn encoder_bytes(image: &ExrImage, args: &MergeArgs) -> u64 {
+    let n = image.beauty.pixels().len() as u64;
+    let png = if args.output.is_some() { 6 * n } else { 0 };
+    let exr = if args.exr.is_some() {
+        let alpha = if image.alpha.is_some() { 4 } else { 0 };
+        let layers: u64 = image
+            .layers
+            .iter()
+            .map(|l| match l.data {
+                LayerData::Rgb(_) => 12,
+                LayerData::Scalar { .. } => 4,
+            })
+            .sum();
+        (12 + alpha + layers) * n
+    } else {
+        0
+    };
+    png.max(exr)
 }

@@ -54,6 +54,13 @@ pub enum OutputError {
         /// The codec's error.
         source: exr::error::Error,
     },
+    /// The pixels of an image being read do not fit in the memory granted.
+    Memory {
+        /// The file.
+        path: PathBuf,
+        /// What was refused.
+        source: crate::memory::OutOfMemory,
+    },
     /// A required channel is not in the file.
     MissingChannel {
         /// The file.
@@ -152,6 +159,7 @@ impl fmt::Display for OutputError {
             } => {
                 write!(f, "{}: {action}: {source}", path.display())
             }
+            OutputError::Memory { path, source } => write!(f, "{}: {source}", path.display()),
             OutputError::ReadOnly { path } => write!(
                 f,
                 "{}: the file is read-only; lucent does not replace it (make it writable or \

@@ -50,6 +50,7 @@ use super::atomic::write_atomically;
 use super::image::{MAX_PIXELS, is_valid_name};
 use super::tile::{EXPOSURE_ATTRIBUTE, Placement};
 use super::{Layer, LayerData, OutputError, RgbImage};
+use crate::memory;
 
 /// The most channels a part may have for lucent to read it.
 const MAX_CHANNELS: usize = 1024;
@@ -303,6 +304,20 @@ fn load_channels(path: &Path) -> Result<(Vec<Channel>, Frame), OutputError> {
             ));
         }
     }
+    // The decoder's samples and their f32 copies live together while the channels are
+    // gathered, 8 bytes per sample at most; ask for that first, as a refusal inside the
+    // decoder would abort.
+    let samples: u64 = meta
+        .headers
+        .iter()
+        .map(|h| h.layer_size.0 as u64 * h.layer_size.1 as u64 * h.channels.list.len() as u64)
+        .sum();
+    memory::probe(samples.saturating_mul(8), memory::READ_IMAGE).map_err(|source| {
+        OutputError::Memory {
+            path: path.to_path_buf(),
+            source,
+        }
+    })?;
     reader
         .seek(SeekFrom::Start(0))
         .map_err(|e| OutputError::io(path, "seeking in the EXR failed", e))?;

@@ -116,3 +116,63 @@ fn outputs_larger_than_memory_are_an_error() {
         ],
     );
 }
+
+/// An 8 × 8 tile of a 16384 × 4096 image, rendered.
+fn small_tile_of_a_huge_image() -> Vec<u8> {
+    let render = Sandbox::new("memory-tile-render");
+    render.succeeds(&[
+        "scene.toml",
+        "--width",
+        "16384",
+        "--height",
+        "4096",
+        "--aa",
+        "1",
+        "--crop",
+        "0,0,8,8",
+        "--exr",
+        "tile.exr",
+    ]);
+    render.read("tile.exr")
+}
+
+/// A tile that claims a whole image of 16384 × 4096 pixels, merged under 200 MiB of address
+/// space: the coverage check needs no buffer of the image's size, so the missing tiles are
+/// named instead of the process aborting on a per-pixel map.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_tile_of_a_huge_image_is_checked_without_its_memory() {
+    let merge = Sandbox::new("memory-tile-merge").with_address_space(200 << 10);
+    merge.write("tile.exr", &small_tile_of_a_huge_image());
+    merge.fails(
+        &["merge", "tile.exr", "-o", "out.png"],
+        1,
+        &["the tiles leave 67108800 of the 16384×4096 pixels uncovered (the first at (8, 0)"],
+    );
+}
+
+/// An EXR whose header promises 8192 × 4096 pixels of seven channels (its data window
+/// widened, its pixel data still an 8 × 8 tile's): the reader asks for what decoding it
+/// would take (1.8 GiB) before the decoder allocates it, and names the file.
+#[test]
+#[cfg(target_os = "linux")]
+fn an_exr_larger_than_memory_is_refused_before_it_is_decoded() {
+    let mut exr = small_tile_of_a_huge_image();
+    let key = b"dataWindow\0box2i\0";
+    let at = exr
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("the tile has a data window")
+        + key.len()
+        + 4;
+    for (i, v) in [0i32, 0, 8191, 4095].into_iter().enumerate() {
+        exr[at + 4 * i..at + 4 * i + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    let sb = Sandbox::new("memory-exr").with_address_space(LIMIT_KIB / 2);
+    sb.write("big.exr", &exr);
+    sb.fails(
+        &["merge", "big.exr", "-o", "out.png"],
+        1,
+        &["big.exr: out of memory: could not allocate 1.8 GiB for the image's pixels"],
+    );
+}
