@@ -14,7 +14,9 @@ use crate::memory;
 use crate::output::{
     Placement, Region, output_target, refuse_read_only, write_exr, write_exr_tile, write_png,
 };
-use crate::render::{self, RenderOptions, read_baked, write_baked};
+use crate::render::{
+    self, LIGHTING_COMMENT, METHOD_COMMENT, RenderOptions, read_baked_with_provenance, write_baked,
+};
 use crate::scene::{
     MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_THREADS, OutputSettings,
     SampleDensity, SampleRequest, Scene, default_scene, files_read, load_scene,
@@ -339,7 +341,11 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
     check_outputs(&outputs, &inputs)?;
     let baked = match &args.samples_from {
         Some(path) => {
-            let groups = read_baked(path).map_err(|e| e.to_string())?;
+            let (groups, provenance) =
+                read_baked_with_provenance(path).map_err(|e| e.to_string())?;
+            for warning in provenance.warnings(&scene, path) {
+                errln!("warning: {warning}");
+            }
             Some(render::match_baked(&scene, groups).map_err(|e| e.to_string())?)
         }
         None => None,
@@ -448,7 +454,11 @@ pub fn bake(args: &BakeArgs) -> Result<(), String> {
     let provenance = [
         format!("scene {source}"),
         format!("seed {}", scene.render.seed),
-        format!("method {}", scene.render.method),
+        format!("{METHOD_COMMENT}{}", scene.render.method),
+        format!(
+            "{LIGHTING_COMMENT} {:016x}",
+            render::lighting_digest(&scene)
+        ),
     ];
     write_baked(&args.output, &sets, &names, &provenance).map_err(|e| e.to_string())?;
     if !args.quiet {

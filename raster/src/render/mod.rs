@@ -39,7 +39,10 @@ use lucent_core::{IrradianceCache, QuerySettings};
 use rayon::prelude::*;
 
 pub use adaptive::{GroupScratch, ShadeGroup};
-pub use baked::{OBJECT_COMMENT, match_baked, read_baked, write_baked};
+pub use baked::{
+    LIGHTING_COMMENT, METHOD_COMMENT, OBJECT_COMMENT, Provenance, lighting_digest, match_baked,
+    read_baked, read_baked_with_provenance, write_baked,
+};
 pub use convexity::cannot_shadow_itself;
 pub use density::{DensityOrigin, DensityPlan};
 pub use error::RenderError;

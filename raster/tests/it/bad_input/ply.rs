@@ -34,6 +34,72 @@ fn baked_samples_render() {
     assert!(sb.read("out.png").starts_with(b"\x89PNG"));
 }
 
+/// A render from a bake whose objects or lights have changed since warns, once, naming the
+/// file, and still renders; one whose camera, material coefficients or shading settings
+/// changed does not, since the samples do not depend on them.
+#[test]
+fn samples_baked_for_other_lights_or_meshes_warn() {
+    let (sb, _, _) = baked("ply-stale");
+    let original = String::from_utf8(sb.read("scene.toml")).expect("utf-8");
+    let stderr_with = |text: &str| {
+        sb.write("scene.toml", text.as_bytes());
+        let out = sb.succeeds(&from_samples());
+        String::from_utf8(out.stderr).expect("utf-8")
+    };
+    let unchanged = [
+        original.clone(),
+        original.replace("fov = 35.0", "fov = 30.0"),
+        original.replace("eta = 1.3", "eta = 1.4"),
+        original.replace("width = 32", "width = 24"),
+    ];
+    for text in &unchanged {
+        let stderr = stderr_with(text);
+        assert!(!stderr.contains("warning"), "{stderr}");
+    }
+    let stale = [
+        original.replace("position = [0.0, -3.0, 5.0]", "position = [0.0, -3.0, 4.0]"),
+        original.replace("segments = 24", "segments = 25"),
+        original.replace("translate = [0.0, 0.0, 0.5]", "translate = [0.0, 0.0, 0.6]"),
+        original
+            .replace(
+                "albedo = [0.2, 0.2, 0.2]",
+                "kd = [0.2, 0.2, 0.2]\nmean_free_path = 0.1\neta = 1.3",
+            )
+            .replace("type = \"lambert\"", "type = \"translucent\""),
+    ];
+    // The scene's method, edge-aware, lights samples at their positions, as hierarchical
+    // does; edge-refined as means over their cells.
+    sb.write("scene.toml", original.as_bytes());
+    for (method, warns) in [
+        ("edge-refined", true),
+        ("hierarchical", false),
+        ("edge-aware", false),
+    ] {
+        let mut args = from_samples();
+        args.extend(["--method", method]);
+        let stderr = String::from_utf8(sb.succeeds(&args).stderr).expect("utf-8");
+        let expected = "warning: samples.ply: baked for edge-aware, whose samples are lit at \
+                        their positions; edge-refined lights its own as means over their cells \
+                        (bake with --method edge-refined)";
+        assert_eq!(stderr.contains(expected), warns, "{method}: {stderr}");
+        assert_eq!(
+            stderr.matches("warning").count(),
+            usize::from(warns),
+            "{stderr}"
+        );
+    }
+    for text in &stale {
+        assert_ne!(text, &original, "the edit applies");
+        let stderr = stderr_with(text);
+        assert!(
+            stderr.starts_with(
+                "warning: samples.ply: baked for other objects or lights than this scene has"
+            ) && stderr.matches("warning").count() == 1,
+            "{stderr}"
+        );
+    }
+}
+
 #[test]
 fn missing_samples_file() {
     let sb = Sandbox::new("ply-missing");
