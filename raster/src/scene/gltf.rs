@@ -98,7 +98,7 @@ pub fn parse_gltf(
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let what = format!("buffer {}", buffer.index());
-        let data = match buffer.source() {
+        let mut data = match buffer.source() {
             gltf::buffer::Source::Bin => blob
                 .take()
                 .ok_or_else(|| fail(format!("{what} is the GLB binary chunk, which is missing")))?,
@@ -112,6 +112,9 @@ pub fn parse_gltf(
                 data.len()
             )));
         }
+        // The buffer is its declared length: a view beyond it is an error even where the
+        // file holds more bytes (a GLB chunk's padding, or a URI's longer file).
+        data.truncate(buffer.length());
         buffers.push(data);
     }
     let scene = document

@@ -333,6 +333,12 @@ fn malformed_files_are_errors_naming_the_problem() {
             "declares 400 bytes",
         ),
         (
+            // The views reach byte 140; the data has them, but the buffer is 136 bytes long.
+            with(node, ONE_PRIMITIVE, &embedded())
+                .replace("\"byteLength\": 140", "\"byteLength\": 136"),
+            "buffer view 1 (bytes 128..+12) lies outside its buffer of 136 bytes",
+        ),
+        (
             with(
                 node,
                 ONE_PRIMITIVE,
