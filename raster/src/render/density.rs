@@ -151,11 +151,15 @@ impl DensityPlan {
             DensityOrigin::Spacing(_) => "from spacing".to_string(),
             DensityOrigin::Baked => "baked".to_string(),
         };
-        format!(
-            "{how}: spacing {:.3} = {:.2} ℓ_d",
-            Sig(self.spacing()),
-            self.ratio()
-        )
+        // Two decimals for the usual ratios (0.25 ℓ_d for auto); significant digits below
+        // 0.1, where two decimals would print 0.00 for a dense set.
+        let ratio = self.ratio();
+        let ratio = if ratio < 0.1 {
+            Sig(ratio).to_string()
+        } else {
+            format!("{ratio:.2}")
+        };
+        format!("{how}: spacing {:.3} = {ratio} ℓ_d", Sig(self.spacing()))
     }
 
     /// The under-resolution warning for `method`, if the spacing is above [`WARN_SPACING`] ·
@@ -656,6 +660,9 @@ mod tests {
             capped.describe(),
             "auto, capped at 100000: spacing 0.0512 = 1.88 ℓ_d"
         );
+        // A dense set keeps significant digits of its ratio (two decimals would give 0.02).
+        let dense = plan_with(DensityOrigin::Count, 4_000_000, 0.4);
+        assert_eq!(dense.describe(), "given: spacing 0.00810 = 0.0202 ℓ_d");
         // Spacings and baked sets.
         let s = plan_with(DensityOrigin::Spacing(0.05), 104_830, 0.0273);
         assert!(
