@@ -18,7 +18,7 @@ use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialRef, MaterialTable, ObjGroups, split_by_material};
 use super::origin::SceneOrigin;
-use super::sanity::{normals_against_winding, orient_outward};
+use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
 use super::weld::{MAX_CREASE_DEGREES, weld_normals};
 
@@ -160,6 +160,21 @@ pub(crate) fn build_object(
                     (mesh, flipped.into_iter().chain(against).collect())
                 }
             };
+            let drop_groups = |keep: &[bool]| {
+                if let Some(g) = groups.as_mut() {
+                    let mut i = 0;
+                    // One group per triangle; anything beyond the triangles is kept as is.
+                    g.triangle_groups.retain(|_| {
+                        i += 1;
+                        keep.get(i - 1).copied().unwrap_or(true)
+                    });
+                }
+            };
+            let mut mesh = mesh;
+            let warnings: Vec<String> = drop_coincident_triangles(&mut mesh, drop_groups)
+                .into_iter()
+                .chain(warnings)
+                .collect();
             for warning in &warnings {
                 let at = c.at(
                     SceneErrorKind::Mesh,

@@ -1,14 +1,65 @@
 //! Mesh sanity checks that repair or warn rather than reject: a closed mesh wound inside out
-//! is turned outside in again, and file normals that contradict the winding are reported.
+//! is turned outside in again, file normals that contradict the winding are reported, and
+//! triangles that repeat another's three corners are dropped.
 //!
-//! Both work on the mesh's *topology by position*: vertices at bit-identical positions are the
+//! All work on the mesh's *topology by position*: vertices at bit-identical positions are the
 //! same point ([`position_ids`]), because files split a vertex wherever its UV or normal
 //! changes, which would otherwise open every seam.
 
 use glam::{DVec3, Vec3};
 
+use super::mesh::drop_unused_vertices;
 use super::model::Mesh;
 use super::weld::position_ids;
+
+/// Drops every triangle whose three corners (by position, in any order or winding) are those
+/// of an earlier triangle, and says how many. Such copies lay the same surface twice: the
+/// irradiance samples would be placed on it as on a surface that much larger, then thinned
+/// against each other at a cost that grows with the square of the copies (a thousand copies
+/// of one triangle took over ten minutes), and the surface would scatter twice the light.
+/// `keep_with` receives the mask of kept triangles first, so that per-triangle data (an OBJ's
+/// material groups) stays aligned.
+pub fn drop_coincident_triangles(
+    mesh: &mut Mesh,
+    keep_with: impl FnOnce(&[bool]),
+) -> Option<String> {
+    let ids = position_ids(&mesh.positions);
+    let mut keys: Vec<([u32; 3], u32)> = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let mut k = t.map(|v| ids[v as usize]);
+            k.sort_unstable();
+            (k, i as u32)
+        })
+        .collect();
+    keys.sort_unstable();
+    let mut keep = vec![true; mesh.triangles.len()];
+    let mut dropped = 0usize;
+    for pair in keys.windows(2) {
+        // Sorted by (corners, index): within a run of equal corners the first is the earliest.
+        if pair[0].0 == pair[1].0 {
+            keep[pair[1].1 as usize] = false;
+            dropped += 1;
+        }
+    }
+    if dropped == 0 {
+        return None;
+    }
+    keep_with(&keep);
+    let total = mesh.triangles.len();
+    let mut i = 0;
+    mesh.triangles.retain(|_| {
+        i += 1;
+        keep[i - 1]
+    });
+    drop_unused_vertices(mesh);
+    Some(format!(
+        "{dropped} of its {total} triangles repeat the corners of another (coincident copies); \
+         they were dropped"
+    ))
+}
 
 /// Whether every edge of the mesh (by position) is used exactly once in each direction: the
 /// surface is closed and consistently wound, so its winding says inside from outside.
@@ -119,6 +170,57 @@ mod tests {
             t.swap(1, 2);
         }
         m
+    }
+
+    /// Copies of a box's triangles, at other vertex indices and with other windings and
+    /// corner orders, are dropped; the per-triangle data follows; the box is left as it was.
+    #[test]
+    fn coincident_copies_of_triangles_are_dropped() {
+        let good = shapes::cuboid(Vec3::new(1.0, 2.0, 3.0));
+        let mut m = good.clone();
+        let n = m.positions.len() as u32;
+        m.positions.extend_from_within(..);
+        m.normals.extend_from_within(..);
+        if let Some(uvs) = &mut m.uvs {
+            uvs.extend_from_within(..);
+        }
+        // Triangle k again at the copied vertices, rotated or reversed by k.
+        let copies: Vec<[u32; 3]> = m
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(k, t)| match k % 3 {
+                0 => t.map(|v| v + n),
+                1 => [t[1] + n, t[2] + n, t[0] + n],
+                _ => [t[2] + n, t[1] + n, t[0] + n],
+            })
+            .collect();
+        m.triangles.extend(copies.iter().step_by(2));
+        m.triangles.extend(&copies);
+        // A triangle sharing two corners only is not a copy.
+        m.triangles.push([0, 1, 6]);
+        let tags: Vec<usize> = (0..m.triangles.len()).collect();
+        let mut kept_tags = tags.clone();
+        let w = drop_coincident_triangles(&mut m, |keep| {
+            let mut i = 0;
+            kept_tags.retain(|_| {
+                i += 1;
+                keep[i - 1]
+            });
+        })
+        .expect("copies found");
+        assert!(
+            w.starts_with("18 of its 31 triangles repeat the corners"),
+            "{w}"
+        );
+        assert_eq!(kept_tags, (0..12).chain([30]).collect::<Vec<_>>());
+        assert_eq!(m.triangles[..12], good.triangles[..]);
+        assert_eq!(m.positions, good.positions);
+        assert_eq!(m.triangles[12], [0, 1, 6]);
+        assert_eq!(
+            drop_coincident_triangles(&mut m, |_| panic!("no copies")),
+            None
+        );
     }
 
     #[test]

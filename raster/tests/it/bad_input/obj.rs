@@ -45,6 +45,44 @@ fn valid_obj_renders() {
     sb.succeeds(&render(&[]));
 }
 
+/// The octahedron with 500 coincident copies of its faces, half of them wound the other way:
+/// the copies are dropped with one warning, and the render is the octahedron's (before, the
+/// sampler placed and thinned samples on 500 layers of the same surface).
+#[test]
+fn coincident_copies_of_faces_are_dropped_with_a_warning() {
+    let sb = mesh_sandbox("obj-copies");
+    sb.succeeds(&render(&[]));
+    let single = sb.read("out.png");
+    let mut obj = OCTAHEDRON.to_string();
+    for k in 0..500 {
+        let face = OCTAHEDRON
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .nth(k % 8);
+        let face = face.expect("eight faces");
+        if k % 2 == 0 {
+            obj.push_str(face);
+        } else {
+            let corners: Vec<&str> = face.split_whitespace().skip(1).collect();
+            obj.push_str(&format!("f {} {} {}", corners[2], corners[1], corners[0]));
+        }
+        obj.push('\n');
+    }
+    sb.write("mesh.obj", obj.as_bytes());
+    let out = sb.succeeds(&render(&[]));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("warning: scene.toml:12:")
+            && stderr.contains(
+                "`mesh.obj`: 500 of its 508 triangles repeat the corners of another \
+                 (coincident copies); they were dropped"
+            )
+            && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+    assert_eq!(sb.read("out.png"), single, "the octahedron's image");
+}
+
 #[test]
 fn missing_obj() {
     let sb = Sandbox::with_scene("obj-missing", &scene("obj = \"nosuch.obj\"", CONSTANT));
