@@ -18,7 +18,9 @@ use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialRef, MaterialTable, ObjGroups, split_by_material};
 use super::origin::SceneOrigin;
-use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
+use super::sanity::{
+    drop_coincident_triangles, normals_against_winding, orient_outward, retain_flagged,
+};
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
 use super::weld::{MAX_CREASE_DEGREES, weld_normals};
 
@@ -162,12 +164,7 @@ pub(crate) fn build_object(
             };
             let drop_groups = |keep: &[bool]| {
                 if let Some(g) = groups.as_mut() {
-                    let mut i = 0;
-                    // One group per triangle; anything beyond the triangles is kept as is.
-                    g.triangle_groups.retain(|_| {
-                        i += 1;
-                        keep.get(i - 1).copied().unwrap_or(true)
-                    });
+                    retain_flagged(&mut g.triangle_groups, keep);
                 }
             };
             let mut mesh = mesh;

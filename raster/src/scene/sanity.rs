@@ -49,16 +49,21 @@ pub fn drop_coincident_triangles(
     }
     keep_with(&keep);
     let total = mesh.triangles.len();
-    let mut i = 0;
-    mesh.triangles.retain(|_| {
-        i += 1;
-        keep[i - 1]
-    });
+    retain_flagged(&mut mesh.triangles, &keep);
     drop_unused_vertices(mesh);
     Some(format!(
         "{dropped} of its {total} triangles repeat the corners of another (coincident copies); \
          they were dropped"
     ))
+}
+
+/// Keeps the elements of `v` whose flag in `keep` is set (and any beyond `keep`'s end).
+pub fn retain_flagged<T>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut i = 0;
+    v.retain(|_| {
+        i += 1;
+        keep.get(i - 1).copied().unwrap_or(true)
+    });
 }
 
 /// Whether every edge of the mesh (by position) is used exactly once in each direction: the
@@ -201,14 +206,8 @@ mod tests {
         m.triangles.push([0, 1, 6]);
         let tags: Vec<usize> = (0..m.triangles.len()).collect();
         let mut kept_tags = tags.clone();
-        let w = drop_coincident_triangles(&mut m, |keep| {
-            let mut i = 0;
-            kept_tags.retain(|_| {
-                i += 1;
-                keep[i - 1]
-            });
-        })
-        .expect("copies found");
+        let w = drop_coincident_triangles(&mut m, |keep| retain_flagged(&mut kept_tags, keep))
+            .expect("copies found");
         assert!(
             w.starts_with("18 of its 31 triangles repeat the corners"),
             "{w}"
