@@ -9,7 +9,8 @@
 //! lucent: shading 45% after 0:01:23, about 0:01:41 left
 //! ```
 //!
-//! Short phases write nothing, so a typical render's stderr stays the summary line alone.
+//! Short phases write nothing, so a typical render's stderr holds its warnings alone (the
+//! summary line goes to stdout).
 
 use std::io::{IsTerminal, Write};
 use std::sync::{Arc, Mutex};

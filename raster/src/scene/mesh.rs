@@ -117,27 +117,28 @@ pub fn drop_unused_vertices(mesh: &mut Mesh) {
             next += 1;
         }
     }
-    mesh.positions = keep(&mesh.positions, &used);
+    retain_flagged(&mut mesh.positions, &used);
     if mesh.normals.len() == used.len() {
-        mesh.normals = keep(&mesh.normals, &used);
+        retain_flagged(&mut mesh.normals, &used);
     }
-    if let Some(uvs) = &mesh.uvs
+    if let Some(uvs) = &mut mesh.uvs
         && uvs.len() == used.len()
     {
-        mesh.uvs = Some(keep(uvs, &used));
+        retain_flagged(uvs, &used);
     }
     for t in &mut mesh.triangles {
         *t = t.map(|i| remap[i as usize]);
     }
 }
 
-/// The elements of `v` whose flag in `used` is set.
-fn keep<T: Copy>(v: &[T], used: &[bool]) -> Vec<T> {
-    v.iter()
-        .zip(used)
-        .filter(|(_, u)| **u)
-        .map(|(x, _)| *x)
-        .collect()
+/// Keeps the elements of `v` whose flag in `keep` is set (and any beyond `keep`'s end): per
+/// vertex or per triangle data, kept aligned with the vertices or triangles a repair keeps.
+pub fn retain_flagged<T>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut i = 0;
+    v.retain(|_| {
+        i += 1;
+        keep.get(i - 1).copied().unwrap_or(true)
+    });
 }
 
 /// The largest accepted coordinate magnitude (scene units), in object and world space.

@@ -12,15 +12,13 @@ use super::check::{Check, Checked};
 use super::error::SceneErrorKind;
 use super::format::RawObject;
 use super::gltf::{GltfMesh, parse_gltf};
-use super::mesh::{Transform, validate_mesh};
+use super::mesh::{Transform, retain_flagged, validate_mesh};
 use super::mesh_file::{MESH_EXTENSIONS, MeshFileError, MeshFormat, parse_mesh_file};
 use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialRef, MaterialTable, ObjGroups, split_by_material};
 use super::origin::SceneOrigin;
-use super::sanity::{
-    drop_coincident_triangles, normals_against_winding, orient_outward, retain_flagged,
-};
+use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
 use super::weld::{MAX_CREASE_DEGREES, weld_normals};
 
@@ -122,7 +120,7 @@ pub(crate) fn build_object(
             c.forbid(&key("radius"), &o.radius, what)?;
             c.forbid(&key("segments"), &o.segments, what)?;
             let loaded = load_mesh(c, &key(name), file, origin)?;
-            let (mesh, warnings) = match loaded {
+            let (mut mesh, warnings) = match loaded {
                 Loaded::Obj(obj) => {
                     groups = Some(ObjGroups::from(&obj));
                     (obj.mesh, obj.warnings)
@@ -167,7 +165,6 @@ pub(crate) fn build_object(
                     retain_flagged(&mut g.triangle_groups, keep);
                 }
             };
-            let mut mesh = mesh;
             let warnings: Vec<String> = drop_coincident_triangles(&mut mesh, drop_groups)
                 .into_iter()
                 .chain(warnings)

@@ -8,7 +8,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::mesh::drop_unused_vertices;
+use super::mesh::{drop_unused_vertices, retain_flagged};
 use super::model::Mesh;
 use super::weld::position_ids;
 
@@ -55,15 +55,6 @@ pub fn drop_coincident_triangles(
         "{dropped} of its {total} triangles repeat the corners of another (coincident copies); \
          they were dropped"
     ))
-}
-
-/// Keeps the elements of `v` whose flag in `keep` is set (and any beyond `keep`'s end).
-pub fn retain_flagged<T>(v: &mut Vec<T>, keep: &[bool]) {
-    let mut i = 0;
-    v.retain(|_| {
-        i += 1;
-        keep.get(i - 1).copied().unwrap_or(true)
-    });
 }
 
 /// Whether every edge of the mesh (by position) is used exactly once in each direction: the
