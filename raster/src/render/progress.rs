@@ -96,10 +96,10 @@ fn log_line(message: &str, position: u64, length: Option<u64>, elapsed: Duration
     let mut line = format!("lucent: {message} {percent}% after {}", clock(elapsed));
     if position > 0 && position < length {
         let left = elapsed.as_secs_f64() * (length - position) as f64 / position as f64;
-        line.push_str(&format!(
-            ", about {} left",
-            clock(Duration::from_secs_f64(left))
-        ));
+        // Beyond what a Duration holds there is no estimate worth printing.
+        if let Ok(left) = Duration::try_from_secs_f64(left) {
+            line.push_str(&format!(", about {} left", clock(left)));
+        }
     }
     line
 }
@@ -132,6 +132,11 @@ mod tests {
             "lucent: irradiance 100% after 1:02:05"
         );
         assert_eq!(log_line("x", 5, None, s(0)), "lucent: x after 0:00:00");
+        // A time left beyond a Duration's range is left out, not a panic.
+        assert_eq!(
+            log_line("x", 1, Some(u64::MAX), s(u64::MAX / 2)),
+            format!("lucent: x 0% after {}", clock(s(u64::MAX / 2)))
+        );
         assert_eq!(log_line("x", 5, Some(0), s(0)), "lucent: x after 0:00:00");
     }
 
