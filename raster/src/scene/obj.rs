@@ -18,10 +18,11 @@ use std::io::BufReader;
 use glam::{Vec2, Vec3};
 
 use super::mesh::{
-    drop_unused_vertices, reject_non_finite, smooth_normals, unit_normal, validate_mesh,
+    drop_unused_vertices, reject_non_finite, retain_flagged, smooth_normals, unit_normal,
+    validate_mesh,
 };
 use super::model::Mesh;
-use super::sanity::{normals_against_winding, orient_outward};
+use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
 
 /// Why an OBJ file could not be used.
 #[derive(Clone, Debug, PartialEq)]
@@ -263,13 +264,27 @@ fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh
         ));
     }
     mesh.uvs = all_uvs.then_some(uvs);
+    if all_normals && normals.len() == mesh.positions.len() {
+        // Held in the mesh while copies and unused vertices are dropped, so that they stay
+        // aligned with the vertices kept.
+        mesh.normals = normals;
+    }
     reject_non_finite(&mesh).map_err(fail)?;
+    // Before the winding is checked: copies make a closed surface look open.
+    let mut warnings: Vec<String> =
+        drop_coincident_triangles(&mut mesh, |keep| retain_flagged(&mut triangle_groups, keep))
+            .into_iter()
+            .collect();
     drop_unused_vertices(&mut mesh);
     // File normals are only trusted when every vertex has a usable one.
-    let units: Option<Vec<Vec3>> = (all_normals && normals.len() == mesh.positions.len())
-        .then(|| normals.into_iter().map(unit_normal).collect())
+    let units: Option<Vec<Vec3>> = (!mesh.normals.is_empty())
+        .then(|| {
+            std::mem::take(&mut mesh.normals)
+                .into_iter()
+                .map(unit_normal)
+                .collect()
+        })
         .flatten();
-    let mut warnings = Vec::new();
     if let Some(units) = units {
         mesh.normals = units;
         warnings.extend(orient_outward(&mut mesh, true));

@@ -120,7 +120,8 @@ pub(crate) fn build_object(
             c.forbid(&key("radius"), &o.radius, what)?;
             c.forbid(&key("segments"), &o.segments, what)?;
             let loaded = load_mesh(c, &key(name), file, origin)?;
-            let (mut mesh, warnings) = match loaded {
+            let (mesh, warnings) = match loaded {
+                // The OBJ loader has dropped coincident copies and oriented the mesh itself.
                 Loaded::Obj(obj) => {
                     groups = Some(ObjGroups::from(&obj));
                     (obj.mesh, obj.warnings)
@@ -146,29 +147,33 @@ pub(crate) fn build_object(
                         gltf.mesh.triangles.len(),
                     ));
                     let mut mesh = gltf.mesh;
+                    let copies = drop_coincident_triangles(&mut mesh, |keep| {
+                        if let Some(g) = groups.as_mut() {
+                            retain_flagged(&mut g.triangle_groups, keep);
+                        }
+                    });
                     let flipped = orient_outward(&mut mesh, true);
                     let against = normals_against_winding(&mesh);
-                    (mesh, flipped.into_iter().chain(against).collect())
+                    (
+                        mesh,
+                        copies.into_iter().chain(flipped).chain(against).collect(),
+                    )
                 }
                 Loaded::Other(mut mesh) => {
                     c.forbid(&key("materials"), &o.materials, "a PLY mesh")?;
                     // The same repairs as for OBJ files. The normals are the file's or were
                     // computed from the winding: either way they follow the flip when they
-                    // agreed with the inverted winding.
+                    // agreed with the inverted winding. Copies go first: they make a closed
+                    // surface look open.
+                    let copies = drop_coincident_triangles(&mut mesh, |_| {});
                     let flipped = orient_outward(&mut mesh, true);
                     let against = normals_against_winding(&mesh);
-                    (mesh, flipped.into_iter().chain(against).collect())
+                    (
+                        mesh,
+                        copies.into_iter().chain(flipped).chain(against).collect(),
+                    )
                 }
             };
-            let drop_groups = |keep: &[bool]| {
-                if let Some(g) = groups.as_mut() {
-                    retain_flagged(&mut g.triangle_groups, keep);
-                }
-            };
-            let warnings: Vec<String> = drop_coincident_triangles(&mut mesh, drop_groups)
-                .into_iter()
-                .chain(warnings)
-                .collect();
             for warning in &warnings {
                 let at = c.at(
                     SceneErrorKind::Mesh,

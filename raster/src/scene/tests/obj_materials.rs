@@ -108,6 +108,27 @@ fn origin() -> SceneOrigin {
              end_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n"
                 .into(),
         ),
+        // The same with a copy of one face: the copy makes it look open until it is dropped.
+        (
+            "m/inside-out-copy.obj",
+            format!("{INSIDE_OUT}f 2 3 1\n").into(),
+        ),
+        (
+            "m/inside-out-copy.ply",
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+             property float z\nelement face 5\nproperty list uchar int vertex_indices\n\
+             end_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n\
+             3 3 2 1\n"
+                .into(),
+        ),
+        // One triangle and a copy of it with another file normal: the copy's corners are
+        // separate vertices, dropped with it.
+        (
+            "m/copy-normals.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0.6 0.8\nvn 0 0 1\n\
+             f 1//1 2//1 3//1\nf 2//2 3//2 1//2\n"
+                .into(),
+        ),
         (
             "m/latin1.obj",
             b"# caf\xe9\no t\xe9te\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
@@ -333,6 +354,35 @@ fn inside_out_meshes_are_flipped_with_a_warning() {
     let centre = mesh.positions.iter().copied().sum::<glam::Vec3>() / 4.0;
     for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
         assert!(n.dot(*p - centre) > 0.0, "normal {n} at {p} points in");
+    }
+}
+
+#[test]
+fn copies_are_dropped_before_the_winding_is_checked() {
+    for file in ["m/inside-out-copy.obj", "m/inside-out-copy.ply"] {
+        let s = scene(&format!("mesh = \"{file}\"\nmaterial = \"plain\"\n")).unwrap();
+        assert_eq!(s.warnings.len(), 2, "{file}: {:?}", s.warnings);
+        assert!(
+            s.warnings[0].contains("coincident copies"),
+            "{}",
+            s.warnings[0]
+        );
+        assert!(s.warnings[1].contains("inside out"), "{}", s.warnings[1]);
+        let mesh = &s.objects[0].mesh;
+        assert_eq!(mesh.triangles.len(), 4, "{file}");
+        assert!(crate::scene::sanity::signed_volume(mesh) > 0.0, "{file}");
+    }
+}
+
+#[test]
+fn file_normals_stay_with_their_vertices_when_copies_are_dropped() {
+    let s = scene("mesh = \"m/copy-normals.obj\"\nmaterial = \"plain\"\n").unwrap();
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    let mesh = &s.objects[0].mesh;
+    assert_eq!((mesh.positions.len(), mesh.triangles.len()), (3, 1));
+    // The kept triangle's own normals, not the copy's and not ones computed from the winding.
+    for n in &mesh.normals {
+        assert!((*n - glam::Vec3::new(0.0, 0.6, 0.8)).length() < 1e-6, "{n}");
     }
 }
 
