@@ -350,6 +350,9 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         }
         None => None,
     };
+    // Reading the scene, its meshes and textures, and any baked samples: with a large scanned
+    // mesh this can outlast the render.
+    let loaded = start.elapsed();
     let options = RenderOptions {
         baked: baked.as_deref(),
         progress: !args.quiet,
@@ -402,7 +405,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             String::new()
         };
         outln!(
-            "lucent: {}×{}{crop}, {} samples{}, {}: sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries{interpolated}, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads, simd {} → {}",
+            "lucent: {}×{}{crop}, {} samples{}, {}: load {}, prepare {}, sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries{interpolated}, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads, simd {} → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
@@ -410,6 +413,8 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
                 .as_ref()
                 .map_or(String::new(), |d| format!(" ({})", d.describe())),
             scene.render.method.name(),
+            seconds(loaded),
+            seconds(t.prepare),
             seconds(t.sampling),
             seconds(t.irradiance),
             seconds(t.cache),

@@ -199,6 +199,26 @@ fn sample_count_summary_and_warning() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains(" samples (auto"), "{stdout}");
     assert!(stdout.contains("ℓ_d)"), "{stdout}");
+    // Every phase is timed, in the order it runs.
+    let phases = [
+        ": load ",
+        ", prepare ",
+        ", sampling ",
+        ", irradiance ",
+        ", cache ",
+        ", raster ",
+        ", shading ",
+        ", total ",
+    ];
+    let at: Vec<usize> = phases
+        .iter()
+        .map(|p| {
+            stdout
+                .find(p)
+                .unwrap_or_else(|| panic!("`{p}` in {stdout}"))
+        })
+        .collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "{stdout}");
     // The ball's ℓ_d is 0.126 (blue): 20 samples are 3.3 ℓ_d apart, 2 are 11 ℓ_d apart
     // (a black image needs 100 ℓ_d: the unit tests of `render::density` check that text).
     let cases = [
