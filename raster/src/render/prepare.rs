@@ -83,17 +83,27 @@ impl<'s> Prepared<'s> {
         } else {
             (hi - lo).length().max(f32::MIN_POSITIVE)
         };
-        let occluders = (!scene.lights.is_empty() && can_occlude(&scene.objects))
-            .then(|| Bvh::try_build(&triangles))
-            .transpose()?;
-        let others = scene
-            .objects
+        let shadows = !scene.lights.is_empty() && can_occlude(&scene.objects);
+        // Which large objects cannot shadow themselves, checked while the tree is built: on a
+        // scanned mesh of millions of triangles each takes a second or more, and the tree's
+        // build runs on one thread.
+        let large = |object: &Object| {
+            let own = object.mesh.triangles.len();
+            shadows && own > 0 && own.saturating_mul(OWN_BVH_SHARE) >= total
+        };
+        let (occluders, convex) = rayon::join(
+            || shadows.then(|| Bvh::try_build(&triangles)).transpose(),
+            || {
+                let convex = |o: &Object| large(o) && cannot_shadow_itself(&o.mesh);
+                scene.objects.iter().map(convex).collect::<Vec<bool>>()
+            },
+        );
+        let occluders = occluders?;
+        let others = convex
             .iter()
             .enumerate()
-            .map(|(i, object)| {
-                let own = object.mesh.triangles.len();
-                let large = own > 0 && own.saturating_mul(OWN_BVH_SHARE) >= total;
-                (occluders.is_some() && large && cannot_shadow_itself(&object.mesh))
+            .map(|(i, &convex)| {
+                convex
                     .then(|| {
                         let (a, b) = (first_triangle[i] as usize, first_triangle[i + 1] as usize);
                         let rest = memory::collect(
