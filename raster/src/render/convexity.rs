@@ -18,7 +18,10 @@
 //! box entirely behind a plane is skipped, so a convex mesh costs a few boxes per level of the
 //! tree for each face (170 visits per face on a 261k-triangle sphere). The work is
 //! capped at [`WORK_LIMIT`] box and vertex visits; beyond it the mesh is taken to shadow
-//! itself (correct, only slower). A flat mesh is recognised first, in one pass.
+//! itself (correct, only slower). A mesh with many faces tests [`PROBE_FACES`] of them first,
+//! evenly spread: when their visits extrapolate to well over the cap, it is given up then,
+//! not after spending the whole cap (a UV sphere of two million faces would need 1.7 times
+//! the cap). A flat mesh is recognised first, in one pass.
 //!
 //! Tolerances are relative to the bounding-box diagonal of the positions ([`TOLERANCE`]), and
 //! faces whose corners lie within [`DEGENERATE`] of the diagonal of each other have no
@@ -40,6 +43,11 @@ const DEGENERATE: f64 = 4e-6;
 /// Box and vertex visits after which the exhaustive test gives up (the mesh is then assumed
 /// to shadow itself): about half a second at most.
 const WORK_LIMIT: u64 = 200_000_000;
+/// Faces a large mesh's test visits first, spread evenly over it, to estimate its whole work.
+const PROBE_FACES: usize = 1024;
+/// A mesh whose estimated work exceeds the budget by this factor is given up before the full
+/// test (the estimate from [`PROBE_FACES`] faces is within a few percent on smooth meshes).
+const PROBE_MARGIN: f64 = 1.25;
 /// How far (relative to the diagonal) a box's bound must stay behind the tolerance for the box
 /// to be skipped. Coordinates are taken relative to the bounding box's corner, so they are at
 /// most the diagonal, and the boxes' centres, axes and extents round by a few 2⁻⁵² of it.
@@ -52,45 +60,68 @@ const LEAF: usize = 8;
 /// tolerance), which includes flat meshes. Meshes too large for the exhaustive test within
 /// `WORK_LIMIT`, and meshes with non-finite positions, are taken to shadow themselves.
 pub fn cannot_shadow_itself(mesh: &Mesh) -> bool {
-    cannot_shadow_itself_within(mesh, WORK_LIMIT)
+    cannot_shadow_itself_within(mesh, WORK_LIMIT).0
 }
 
-/// [`cannot_shadow_itself`] with a budget of `limit` box and vertex visits.
-fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> bool {
+/// [`cannot_shadow_itself`] with a budget of `limit` box and vertex visits, and the visits
+/// made.
+fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
     let Some((origin, diagonal)) = bounds(&mesh.positions) else {
-        return true;
+        return (true, 0);
     };
     if !diagonal.is_finite() {
-        return false;
+        return (false, 0);
     }
     // A mesh whose test does not fit in memory is taken to shadow itself, like one whose test
     // exceeds the work limit.
     let Ok(planes) = face_planes(mesh, origin, diagonal) else {
-        return false;
+        return (false, 0);
     };
     let Ok(vertices) = referenced_vertices(mesh, origin) else {
-        return false;
+        return (false, 0);
     };
     let tolerance = TOLERANCE * diagonal;
     let Some(widest) = planes.iter().max_by(|a, b| a.area.total_cmp(&b.area)) else {
-        return true; // no face with a plane: nothing a ray could hit but lines and points
+        return (true, 0); // no face with a plane: nothing a ray could hit but lines and points
     };
     if vertices
         .iter()
         .all(|v| widest.distance(v.at).abs() <= tolerance)
     {
-        return true; // flat
+        return (true, 0); // flat
     }
     let Ok(tree) = VertexTree::build(vertices) else {
-        return false;
+        return (false, 0);
     };
+    let margin = MARGIN * diagonal;
+    // A mesh of millions of faces can need more than the budget, and the full test would spend
+    // all of it before giving up: a few faces spread over the mesh tell first. A face that
+    // fails here fails the full test too.
+    let mut probe_visits = 0;
+    if planes.len() > 4 * PROBE_FACES {
+        let stride = planes.len() / PROBE_FACES;
+        let mut probed = 0u64;
+        for plane in planes.iter().step_by(stride) {
+            let (passed, visits) = tree.nothing_in_front(plane, tolerance, margin);
+            probe_visits += visits;
+            probed += 1;
+            if !passed {
+                return (false, probe_visits);
+            }
+        }
+        let estimate = probe_visits as f64 / probed as f64 * planes.len() as f64;
+        if estimate > PROBE_MARGIN * limit as f64 {
+            return (false, probe_visits);
+        }
+    }
     // Faces in parallel. The answer does not depend on the order: true needs every face to
     // pass, and then the total work is the same sum whatever the order.
     let work = AtomicU64::new(0);
-    planes.par_iter().all(|plane| {
-        let (passed, visits) = tree.nothing_in_front(plane, tolerance, MARGIN * diagonal);
+    let passed = planes.par_iter().all(|plane| {
+        let (passed, visits) = tree.nothing_in_front(plane, tolerance, margin);
         passed && work.fetch_add(visits, Ordering::Relaxed) + visits <= limit
-    })
+    });
+    (passed, probe_visits + work.load(Ordering::Relaxed))
 }
 
 /// The smallest corner of the positions' bounding box and its diagonal's length, in f64 (the
@@ -576,7 +607,35 @@ mod tests {
         // The budget stops the test: the sphere is then taken to shadow itself.
         let sphere = shapes::sphere(1.0, 64);
         let needed = (small.0 * sphere.triangles.len() as f64) as u64;
-        assert!(cannot_shadow_itself_within(&sphere, needed + 1000));
-        assert!(!cannot_shadow_itself_within(&sphere, needed / 2));
+        assert!(cannot_shadow_itself_within(&sphere, needed + 1000).0);
+        assert!(!cannot_shadow_itself_within(&sphere, needed / 2).0);
+    }
+
+    #[test]
+    fn a_mesh_far_over_the_budget_is_given_up_after_a_probe() {
+        let sphere = shapes::sphere(1.0, 256);
+        let faces = sphere.triangles.len();
+        assert!(faces > 4 * PROBE_FACES, "{faces} faces");
+        let (per_face, convex) = visits_per_face(&sphere);
+        assert!(convex);
+        let needed = (per_face * faces as f64) as u64;
+        // Within the budget: the probe, then the whole test, passes.
+        let (passed, work) = cannot_shadow_itself_within(&sphere, needed + needed / 4);
+        assert!(passed && work >= needed, "{work} visits for {needed}");
+        // Far over it: given up after the probe's visits, not after the budget's.
+        let (passed, work) = cannot_shadow_itself_within(&sphere, needed / 4);
+        assert!(!passed);
+        let probe = (2.0 * per_face * PROBE_FACES as f64) as u64;
+        assert!(
+            work < probe,
+            "{work} visits, a probe of {PROBE_FACES} faces needs about {probe}"
+        );
+        // A mesh that fails is refused by the probe too: the sphere turned inside out.
+        let mut inverted = sphere.clone();
+        for t in &mut inverted.triangles {
+            t.swap(1, 2);
+        }
+        let (passed, work) = cannot_shadow_itself_within(&inverted, WORK_LIMIT);
+        assert!(!passed && work < probe, "{work} visits");
     }
 }
