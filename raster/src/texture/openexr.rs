@@ -32,6 +32,26 @@ const BLOCK_BYTES_FLOOR: u64 = 64 << 20;
 /// not tied to the image's: a 2.5 KB file declaring 64 × 16 449 600-pixel tiles on a 64 × 64
 /// image made it zero-fill a gigabyte. A real block is a piece of its image, so only a part
 /// smaller than one block (a tiny image in large tiles) comes near the bound.
+/// B44 and B44A are refused: `exr`'s B44 decoder does OpenEXR's unsigned 16-bit arithmetic
+/// with subtractions that wrap, which a build with overflow checks (tests, fuzzing, debug)
+/// turns into a panic on ordinary data. These lossy formats are meant for images to look at,
+/// not for textures read as data.
+fn check_compression(header: &exr::meta::header::Header, path: &Path) -> Result<(), TextureError> {
+    use exr::compression::Compression;
+    let name = match header.compression {
+        Compression::B44 => "B44",
+        Compression::B44A => "B44A",
+        _ => return Ok(()),
+    };
+    Err(TextureError::new(
+        path,
+        format!(
+            "OpenEXR {name} compression is not read (save the texture with ZIP, PIZ or no \
+             compression)"
+        ),
+    ))
+}
+
 fn check_block_size(header: &exr::meta::header::Header, path: &Path) -> Result<(), TextureError> {
     let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
     let bytes_per_pixel = header.channels.bytes_per_pixel as u64;
@@ -99,6 +119,7 @@ pub(super) fn decode_exr(
         samples =
             samples.saturating_add((w as u64).saturating_mul(h as u64).saturating_mul(channels));
         check_block_size(header, path)?;
+        check_compression(header, path)?;
     }
     let max_samples = limits.max_texels.saturating_mul(4);
     if samples > max_samples {

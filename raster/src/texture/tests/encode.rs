@@ -113,6 +113,15 @@ pub(crate) fn exr_channels(
     exr_encoded(width, height, channels, Encoding::FAST_LOSSLESS)
 }
 
+/// A single-part scan-line OpenEXR file with the named channels, B44 compressed.
+pub(crate) fn exr_b44(width: usize, height: usize, channels: Vec<(&str, FlatSamples)>) -> Vec<u8> {
+    let encoding = Encoding {
+        compression: exr::compression::Compression::B44,
+        ..Encoding::FAST_LOSSLESS
+    };
+    exr_encoded(width, height, channels, encoding)
+}
+
 /// An RGB OpenEXR file of 32-bit floats in `tile × tile` tiles, ZIP compressed.
 pub(crate) fn exr_tiled_rgb_f32(width: usize, height: usize, tile: usize) -> Vec<u8> {
     let channel =

@@ -11,8 +11,8 @@ use super::super::{
     srgb_to_linear,
 };
 use super::encode::{
-    bmp_rgb, exr_channels, exr_rgb_f32, exr_tiled_rgb_f32, hdr_rgbe, jpeg_grey, jpeg_rgb, tga_grey,
-    tga_header, tga_rgb,
+    bmp_rgb, exr_b44, exr_channels, exr_rgb_f32, exr_tiled_rgb_f32, hdr_rgbe, jpeg_grey, jpeg_rgb,
+    tga_grey, tga_header, tga_rgb,
 };
 use super::{encode_png, patch_ihdr_size};
 
@@ -179,6 +179,24 @@ fn exr_rgb_half_and_single_channel_are_exact_and_linear() {
     let message = err(&file, "uv.exr");
     assert!(
         message.contains("no R, G, B channels") && message.contains("(channels: U, V)"),
+        "{message}"
+    );
+}
+
+#[test]
+fn exr_b44_is_refused_before_it_is_decoded() {
+    let half = |v: f32| f16::from_f32(v);
+    let file = exr_b44(
+        8,
+        8,
+        vec![(
+            "Y",
+            FlatSamples::F16((0..64).map(|i| half(i as f32)).collect()),
+        )],
+    );
+    let message = err(&file, "b.exr");
+    assert!(
+        message.starts_with("texture b.exr: OpenEXR B44 compression is not read"),
         "{message}"
     );
 }
