@@ -9,8 +9,9 @@
 //! [`MEDIAN_DEPTH`] switch to object-median splits, which halve the count, so no path is longer
 //! than `MEDIAN_DEPTH + 31` for fewer than 2³¹ triangles.
 //!
-//! Single-threaded and free of hashing or randomness, so the tree is a pure function of the
-//! input. Non-finite triangles are left out (and listed); degenerate ones are kept (they have
+//! Free of hashing or randomness, so the tree is a pure function of the input: large subtrees
+//! are built on two threads and spliced where a one-threaded build puts them, so the node
+//! array is the same for any number of threads. Non-finite triangles are left out (and listed); degenerate ones are kept (they have
 //! valid boxes and the triangle test never reports a hit on them).
 
 use glam::Vec3;
@@ -56,6 +57,11 @@ pub(super) struct Built {
     pub skipped: Vec<u32>,
 }
 
+/// Subtrees of at least this many triangles are built on two threads (`rayon::join`), their
+/// halves apart; smaller ones in one go. On a 2 M-triangle mesh, 2¹⁴ leaves a few hundred
+/// pieces, enough for the threads to share the work and few enough that splicing them is cheap.
+const PARALLEL_MIN: usize = 1 << 14;
+
 /// A range of `order` waiting to become node `node`.
 struct Task {
     node: u32,
@@ -64,8 +70,31 @@ struct Task {
     depth: u32,
 }
 
+/// A subtree built apart from the rest: [`place`] splices it into the node array exactly where
+/// the one-threaded build puts it.
+enum Piece {
+    /// A subtree built in one go: its nodes in the one-threaded build's order, root first, an
+    /// interior node's `first` an index into this array.
+    Whole(Vec<BvhNode>),
+    /// A node split here, its two halves built apart.
+    Split {
+        bounds: Aabb,
+        halves: Box<(Piece, Piece)>,
+    },
+}
+
 /// Builds the tree over `triangles` (only the first [`MAX_TRIANGLES`] are looked at).
 pub(super) fn build(triangles: &[[Vec3; 3]]) -> Result<Built, OutOfMemory> {
+    build_splitting_from(triangles, PARALLEL_MIN)
+}
+
+/// [`build`], building subtrees of at least `parallel_min` triangles on two threads. The nodes
+/// are the same for every `parallel_min` (the one-threaded build's), so that tests can compare
+/// a build split into many pieces with one that is not split at all.
+pub(super) fn build_splitting_from(
+    triangles: &[[Vec3; 3]],
+    parallel_min: usize,
+) -> Result<Built, OutOfMemory> {
     let triangles = &triangles[..triangles.len().min(MAX_TRIANGLES)];
     let mut boxes = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
     let mut centroids = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
@@ -88,52 +117,57 @@ pub(super) fn build(triangles: &[[Vec3; 3]]) -> Result<Built, OutOfMemory> {
             skipped,
         });
     }
-    let mut nodes = memory::with_capacity(2 * order.len() - 1, memory::TRIANGLES)?;
-    nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
-    let mut stack = vec![Task {
-        node: 0,
-        start: 0,
-        end: order.len() as u32,
-        depth: 0,
-    }];
     let builder = Builder {
         boxes: &boxes,
         centroids: &centroids,
     };
-    while let Some(task) = stack.pop() {
-        let items = &mut order[task.start as usize..task.end as usize];
-        let (bounds, cbounds) = builder.bounds(items);
-        let n = items.len() as u32;
-        let mid = match builder.choose_split(items, &bounds, &cbounds, task.depth) {
-            None => {
-                nodes[task.node as usize] = BvhNode::new(&bounds, task.start, n);
-                continue;
-            }
-            Some(mid) => mid,
-        };
-        let left = nodes.len() as u32;
-        nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
-        nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
-        nodes[task.node as usize] = BvhNode::new(&bounds, left, 0);
-        let split = task.start + mid;
-        stack.push(Task {
-            node: left + 1,
-            start: split,
-            end: task.end,
-            depth: task.depth + 1,
-        });
-        stack.push(Task {
-            node: left,
-            start: task.start,
-            end: split,
-            depth: task.depth + 1,
-        });
-    }
+    let nodes = match builder.piece(&mut order, 0, 0, parallel_min.max(2))? {
+        Piece::Whole(nodes) => nodes,
+        split => {
+            let mut nodes = memory::with_capacity(2 * order.len() - 1, memory::TRIANGLES)?;
+            nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
+            place(split, 0, &mut nodes);
+            nodes
+        }
+    };
     Ok(Built {
         nodes,
         order,
         skipped,
     })
+}
+
+/// Writes `piece` into `nodes` where the one-threaded build puts it: its root at `slot`, its
+/// descendants appended. That build gives a node's two children adjacent slots when it splits
+/// the node, then lays out the whole left subtree below them before the right one's children,
+/// so a subtree's descendants are contiguous and in the order of [`Builder::whole`]. `nodes`
+/// must have room for them (every caller reserves `2N − 1`).
+fn place(piece: Piece, slot: usize, nodes: &mut Vec<BvhNode>) {
+    match piece {
+        Piece::Whole(own) => {
+            // Index k ≥ 1 of `own` goes to `nodes.len() + k − 1`.
+            let shift = nodes.len() as u32 - 1;
+            nodes[slot] = shifted(own[0], shift);
+            nodes.extend(own[1..].iter().map(|&node| shifted(node, shift)));
+        }
+        Piece::Split { bounds, halves } => {
+            let children = nodes.len();
+            nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
+            nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
+            nodes[slot] = BvhNode::new(&bounds, children as u32, 0);
+            let (left, right) = *halves;
+            place(left, children, nodes);
+            place(right, children + 1, nodes);
+        }
+    }
+}
+
+/// `node` with its children `shift` slots further on (a leaf's triangle slots stay).
+fn shifted(mut node: BvhNode, shift: u32) -> BvhNode {
+    if !node.is_leaf() {
+        node.first += shift;
+    }
+    node
 }
 
 /// Per-triangle data the builder reads.
@@ -151,6 +185,82 @@ struct Split {
 }
 
 impl Builder<'_> {
+    /// The subtree over `items` (the slots from `offset` on of the leaf order, at `depth`),
+    /// its halves built on two threads while it holds at least `parallel_min` triangles.
+    fn piece(
+        &self,
+        items: &mut [u32],
+        offset: u32,
+        depth: u32,
+        parallel_min: usize,
+    ) -> Result<Piece, OutOfMemory> {
+        if items.len() < parallel_min {
+            return self.whole(items, offset, depth).map(Piece::Whole);
+        }
+        let (bounds, cbounds) = self.bounds(items);
+        let Some(mid) = self.choose_split(items, &bounds, &cbounds, depth) else {
+            let leaf = BvhNode::new(&bounds, offset, items.len() as u32);
+            return Ok(Piece::Whole(vec![leaf]));
+        };
+        let (left, right) = items.split_at_mut(mid as usize);
+        let (left, right) = rayon::join(
+            || self.piece(left, offset, depth + 1, parallel_min),
+            || self.piece(right, offset + mid, depth + 1, parallel_min),
+        );
+        Ok(Piece::Split {
+            bounds,
+            halves: Box::new((left?, right?)),
+        })
+    }
+
+    /// The subtree over `items` (the slots from `offset` on of the leaf order, at `depth`) on
+    /// this thread, root first; an interior node's `first` indexes the returned array.
+    fn whole(
+        &self,
+        items: &mut [u32],
+        offset: u32,
+        depth: u32,
+    ) -> Result<Vec<BvhNode>, OutOfMemory> {
+        let mut nodes = memory::with_capacity(2 * items.len() - 1, memory::TRIANGLES)?;
+        nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
+        let mut stack = vec![Task {
+            node: 0,
+            start: 0,
+            end: items.len() as u32,
+            depth,
+        }];
+        while let Some(task) = stack.pop() {
+            let items = &mut items[task.start as usize..task.end as usize];
+            let (bounds, cbounds) = self.bounds(items);
+            let n = items.len() as u32;
+            let mid = match self.choose_split(items, &bounds, &cbounds, task.depth) {
+                None => {
+                    nodes[task.node as usize] = BvhNode::new(&bounds, offset + task.start, n);
+                    continue;
+                }
+                Some(mid) => mid,
+            };
+            let left = nodes.len() as u32;
+            nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
+            nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
+            nodes[task.node as usize] = BvhNode::new(&bounds, left, 0);
+            let split = task.start + mid;
+            stack.push(Task {
+                node: left + 1,
+                start: split,
+                end: task.end,
+                depth: task.depth + 1,
+            });
+            stack.push(Task {
+                node: left,
+                start: task.start,
+                end: split,
+                depth: task.depth + 1,
+            });
+        }
+        Ok(nodes)
+    }
+
     /// Bounds of the triangles and of their centroids.
     fn bounds(&self, items: &[u32]) -> (Aabb, Aabb) {
         let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);

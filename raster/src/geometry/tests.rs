@@ -337,6 +337,47 @@ fn build_is_deterministic() {
 }
 
 #[test]
+fn a_build_split_over_threads_is_the_one_threaded_build() {
+    // Pieces built apart and spliced must give the one-threaded build's node array exactly,
+    // however finely the tree is cut into pieces. The inputs: a random soup (with exact
+    // copies), a closed sphere, and a chain that SAH splits one triangle at a time, deep enough
+    // to reach the object-median splits.
+    let mut rng = Pcg32::new(15, 4);
+    let chain: Vec<[Vec3; 3]> = (0..300)
+        .map(|i| {
+            let x = 1.1f32.powi(i);
+            [
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, 1.0, 0.0),
+                Vec3::new(x, 0.0, 1.0),
+            ]
+        })
+        .collect();
+    let inputs = [
+        random_scene(&mut rng, 3000),
+        icosphere(4, Vec3::ZERO, 1.0),
+        chain,
+    ];
+    for tris in &inputs {
+        let one = build::build_splitting_from(tris, usize::MAX).unwrap();
+        let mut pieces_seen = 0;
+        for parallel_min in [2, 9, 64, 1000] {
+            let split = build::build_splitting_from(tris, parallel_min).unwrap();
+            assert_eq!(
+                split.nodes,
+                one.nodes,
+                "{} triangles, pieces from {parallel_min}",
+                tris.len()
+            );
+            assert_eq!(split.order, one.order);
+            assert_eq!(split.skipped, one.skipped);
+            pieces_seen += usize::from(tris.len() >= parallel_min);
+        }
+        assert!(pieces_seen >= 3, "the inputs must be cut into pieces");
+    }
+}
+
+#[test]
 fn offset_shadow_rays_do_not_hit_their_own_surface() {
     // Points on a sphere far from the origin (so absolute error is large), offset along the
     // outward face normal: rays into the outer hemisphere must escape (the sphere is convex),

@@ -86,7 +86,7 @@ impl<'s> Prepared<'s> {
         let shadows = !scene.lights.is_empty() && can_occlude(&scene.objects);
         // Which large objects cannot shadow themselves, checked while the tree is built: on a
         // scanned mesh of millions of triangles each takes a second or more, and the tree's
-        // build runs on one thread.
+        // build keeps a thread idle while it makes its first splits.
         let large = |object: &Object| {
             let own = object.mesh.triangles.len();
             shadows && own > 0 && own.saturating_mul(OWN_BVH_SHARE) >= total
