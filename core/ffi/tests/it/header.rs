@@ -1,5 +1,5 @@
 //! `include/lucent.h` is what cbindgen generates from the crate today, byte for byte.
-//! `LUCENT_BLESS=1 cargo test -p lucent-ffi --test it header::` regenerates it.
+//! `LUCENT_BLESS=1 cargo test -p lucent-ffi --features header-check --test it header::` regenerates it.
 
 use std::path::Path;
 
@@ -22,7 +22,7 @@ fn header_is_current() {
     let committed = std::fs::read(&path).unwrap_or_default();
     assert!(
         committed == generated,
-        "{} is stale: regenerate it with LUCENT_BLESS=1 cargo test -p lucent-ffi --test it header::",
+        "{} is stale: regenerate it with LUCENT_BLESS=1 cargo test -p lucent-ffi --features header-check --test it header::",
         path.display()
     );
 }

@@ -6,6 +6,8 @@ mod common;
 
 mod cache;
 mod errors;
+// Needs cbindgen: `cargo test -p lucent-ffi --features header-check --test it header::`.
+#[cfg(feature = "header-check")]
 mod header;
 mod profile;
 mod query;
