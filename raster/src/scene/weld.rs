@@ -27,16 +27,31 @@ pub const MAX_CREASE_DEGREES: f32 = 180.0;
 
 /// For each vertex, the index of the first vertex with a bit-identical position (−0 and +0
 /// count as equal), so that equal ids mean the same point.
+///
+/// One sort of (position bits, index): a run of equal positions starts with its lowest index.
+/// A hash map of positions took 3–4 times as long on a million vertices, and a sort's time
+/// does not depend on how the positions collide.
 pub fn position_ids(positions: &[Vec3]) -> Vec<u32> {
-    let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
-    positions
+    let mut keyed: Vec<([u32; 3], u32)> = positions
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            let key = (*p + Vec3::ZERO).to_array().map(f32::to_bits);
-            *first.entry(key).or_insert(i as u32)
-        })
-        .collect()
+        .map(|(i, p)| (position_bits(*p), i as u32))
+        .collect();
+    keyed.sort_unstable();
+    let mut ids = vec![0; positions.len()];
+    let mut first = 0;
+    for (j, &(key, i)) in keyed.iter().enumerate() {
+        if j == 0 || key != keyed[j - 1].0 {
+            first = i;
+        }
+        ids[i as usize] = first;
+    }
+    ids
+}
+
+/// The bits that identify a position: −0 is made +0 (adding +0 does that and nothing else).
+fn position_bits(p: Vec3) -> [u32; 3] {
+    (p + Vec3::ZERO).to_array().map(f32::to_bits)
 }
 
 /// A triangle using a welded edge: (triangle, its corner at the edge's smaller position id,
@@ -288,5 +303,34 @@ mod tests {
     fn position_ids_treat_signed_zeros_alike() {
         let ids = position_ids(&[Vec3::ZERO, Vec3::new(-0.0, 0.0, -0.0), Vec3::X]);
         assert_eq!(ids, vec![0, 0, 2]);
+    }
+
+    #[test]
+    fn position_ids_name_the_first_vertex_at_each_position() {
+        // The definition, vertex by vertex: the smallest index whose position has the same
+        // bits (after −0 → +0). Positions drawn from a small set so that most repeat, with
+        // signed zeros, infinities and NaNs among them.
+        let values = [0.0, -0.0, 1.0, -2.5, f32::INFINITY, f32::NAN, 1e-40];
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut pick = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            values[(state % values.len() as u64) as usize]
+        };
+        let positions: Vec<Vec3> = (0..2000)
+            .map(|_| Vec3::new(pick(), pick(), pick()))
+            .collect();
+        let ids = position_ids(&positions);
+        for (i, p) in positions.iter().enumerate() {
+            let bits = position_bits(*p);
+            let first = positions
+                .iter()
+                .position(|q| position_bits(*q) == bits)
+                .unwrap();
+            assert_eq!(ids[i], first as u32, "vertex {i} at {p}");
+        }
+        assert!(ids.iter().enumerate().any(|(i, &id)| id as usize != i));
+        assert_eq!(position_ids(&[]), Vec::<u32>::new());
     }
 }
