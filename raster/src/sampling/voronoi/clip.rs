@@ -334,9 +334,42 @@ pub(super) fn distance2_to_triangle(p: DVec3, t: &[Vec3; 3]) -> f64 {
     (p - q).length_squared()
 }
 
+/// A lower bound on the squared distance from `p` to triangle `t` as computed here (by
+/// [`distance2_to_triangle`], or from [`nearest_on_triangle`]'s weights): the distance to the
+/// triangle's bounding box, less a slack far above those computations' rounding (a few ulps of
+/// the largest coordinate). A few operations, against the exact test's projections and
+/// branches: a triangle it puts beyond a limit is beyond it for the exact test too, so skipping
+/// it changes no decision. 0 when `p` is within the slack of the box; NaN (no bound) when a
+/// coordinate is NaN. (A triangle whose corners round onto one line has no computed distance,
+/// NaN, and no [`Frame`]: its callers skip it either way.)
+#[inline]
+pub(super) fn box_distance2_below(p: DVec3, t: &[Vec3; 3]) -> f64 {
+    // NaN anywhere makes the sum NaN (as do opposite infinities: no bound there either).
+    if (t[0] + t[1] + t[2]).as_dvec3().is_nan() || p.is_nan() {
+        return f64::NAN;
+    }
+    // min and max are exact in f32.
+    let lo = t[0].min(t[1]).min(t[2]).as_dvec3();
+    let hi = t[0].max(t[1]).max(t[2]).as_dvec3();
+    let gap = (lo - p).max(p - hi).max(DVec3::ZERO);
+    let slack = ROUNDING_SLACK * p.abs().max(lo.abs()).max(hi.abs()).max_element();
+    // (g − s)² ≥ (1 − ε)·g² − s²/ε for any ε > 0 (as 2gs ≤ ε·g² + s²/ε): no square root.
+    let bound = (1.0 - SLACK_SPLIT) * gap.length_squared() - slack * slack / SLACK_SPLIT;
+    bound.max(0.0)
+}
+
+/// The ε of [`box_distance2_below`]'s bound: the bound gives up this fraction of the squared
+/// distance to avoid a square root.
+const SLACK_SPLIT: f64 = 1e-6;
+
+/// [`box_distance2_below`]'s slack, relative to the largest coordinate involved. The computed
+/// nearest point is off the exact one by a few ulps of the coordinates (about 1e-15 relative).
+const ROUNDING_SLACK: f64 = 1e-12;
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::rng::Pcg32;
 
     #[test]
     fn an_unclipped_triangle_keeps_its_area_and_a_bisector_halves_a_square_cell() {
@@ -419,5 +452,51 @@ mod tests {
                 "{d} {best}"
             );
         }
+    }
+
+    #[test]
+    fn the_box_bound_is_below_both_computed_distances() {
+        // Both ways the module computes a distance: `distance2_to_triangle`, and the nearest
+        // point from `nearest_on_triangle`'s weights as the centroids do. Small triangles far
+        // from the origin (where rounding is largest), slivers, points near and far, in and
+        // off the plane.
+        let mut rng = Pcg32::new(31, 7);
+        let mut useful = 0;
+        for case in 0..20_000 {
+            let offset = [0.0, 1.0, 1e3, 3e4][case % 4];
+            let size = [1e-3, 0.1, 1.0][case / 4 % 3];
+            let corner = |rng: &mut Pcg32| {
+                Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32() * 0.01) * size as f32
+                    + Vec3::splat(offset as f32)
+            };
+            let t = [corner(&mut rng), corner(&mut rng), corner(&mut rng)];
+            let reach = size * [0.0, 0.5, 2.0, 20.0][case / 12 % 4];
+            let p = t[0].as_dvec3()
+                + DVec3::new(
+                    rng.next_f32() as f64 - 0.3,
+                    rng.next_f32() as f64 - 0.3,
+                    rng.next_f32() as f64 - 0.5,
+                ) * reach;
+            let bound = box_distance2_below(p, &t);
+            let exact = distance2_to_triangle(p, &t);
+            let w = nearest_on_triangle(p, &t);
+            let q = t[0].as_dvec3() * w[0] + t[1].as_dvec3() * w[1] + t[2].as_dvec3() * w[2];
+            let centroid_way = p.distance_squared(q);
+            if exact.is_nan() {
+                // Corners rounded onto one point or line: no distance (and no `Frame`), so
+                // the callers skip the triangle whatever the bound says.
+                assert!(Frame::new(&t).is_none(), "case {case}");
+                continue;
+            }
+            assert!(
+                bound <= exact && bound <= centroid_way,
+                "case {case}: bound {bound:e}, distances {exact:e} and {centroid_way:e}"
+            );
+            useful += usize::from(bound > 0.25 * exact);
+        }
+        // It must also prune: most points well off a small triangle get a real bound.
+        assert!(useful > 8_000, "{useful}");
+        let nan = [Vec3::NAN, Vec3::ZERO, Vec3::X];
+        assert!(box_distance2_below(DVec3::splat(5.0), &nan).is_nan());
     }
 }

@@ -79,7 +79,10 @@ use rayon::prelude::*;
 
 use super::surface::{SurfacePoint, hex_spacing, triangle_area};
 use cells::Cells;
-use clip::{Frame, Neighbour, Outcome, Polygon, distance2_to_triangle, nearest_on_triangle};
+use clip::{
+    Frame, Neighbour, Outcome, Polygon, box_distance2_below, distance2_to_triangle,
+    nearest_on_triangle,
+};
 
 /// Grid cell edge, in hexagonal-packing spacings. A cell's 3×3×3 block guarantees every
 /// neighbour within one cell edge of its sites, which proves cells whose farthest vertex is
@@ -345,7 +348,11 @@ impl Pass<'_> {
             let (mut area, mut first) = (0.0, DVec3::ZERO);
             for &t in triangles {
                 let tri = &self.triangles[t as usize];
-                if distance2_to_triangle(ps, tri) > self.reach2 {
+                // Most of a grid cell's triangles are beyond the reach of each of its sites:
+                // their bounding boxes say so for a fraction of the exact test's cost.
+                if box_distance2_below(ps, tri) > self.reach2
+                    || distance2_to_triangle(ps, tri) > self.reach2
+                {
                     continue;
                 }
                 let Some(frame) = Frame::new(tri) else {
@@ -553,6 +560,10 @@ impl Pass<'_> {
                     let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0], p);
                     for &t in cells.triangles_of(c) {
                         let tri = &self.triangles[t as usize];
+                        // Not nearer than the best so far (a tie keeps the first): skipped.
+                        if box_distance2_below(p, tri) >= best.0 {
+                            continue;
+                        }
                         let w = nearest_on_triangle(p, tri);
                         let q = tri[0].as_dvec3() * w[0]
                             + tri[1].as_dvec3() * w[1]
