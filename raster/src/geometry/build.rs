@@ -170,7 +170,8 @@ fn shifted(mut node: BvhNode, shift: u32) -> BvhNode {
     node
 }
 
-/// Per-triangle data the builder reads.
+/// Per-triangle data the builder reads. (Tried: each triangle's box and centroid moved with it
+/// through the partitions instead of indices into these arrays: no gain on 2 M triangles.)
 struct Builder<'a> {
     boxes: &'a [Aabb],
     centroids: &'a [Vec3],
