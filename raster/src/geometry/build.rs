@@ -11,8 +11,9 @@
 //!
 //! Free of hashing or randomness, so the tree is a pure function of the input: large subtrees
 //! are built on two threads and spliced where a one-threaded build puts them, so the node
-//! array is the same for any number of threads. Non-finite triangles are left out (and listed); degenerate ones are kept (they have
-//! valid boxes and the triangle test never reports a hit on them).
+//! array is the same for any number of threads. Non-finite triangles are left out (and
+//! listed); degenerate ones are kept (they have valid boxes and the triangle test never
+//! reports a hit on them).
 
 use glam::Vec3;
 
