@@ -24,15 +24,7 @@ use super::{TextureError, TextureLimits, TextureSource};
 /// or 256 scan lines of four float channels at the widest texture (16384 × 256 × 16 bytes).
 const BLOCK_BYTES_FLOOR: u64 = 64 << 20;
 
-/// Refuses a part whose blocks (tiles, or runs of scan lines) hold more bytes than the whole
-/// part, or than [`BLOCK_BYTES_FLOOR`] if that is more.
-///
-/// The decoder reads each block into a buffer of the size the header implies for a block
-/// before it finds out whether the file holds that many bytes, and the header's tile size is
-/// not tied to the image's: a 2.5 KB file declaring 64 × 16 449 600-pixel tiles on a 64 × 64
-/// image made it zero-fill a gigabyte. A real block is a piece of its image, so only a part
-/// smaller than one block (a tiny image in large tiles) comes near the bound.
-/// B44 and B44A are refused: `exr`'s B44 decoder does OpenEXR's unsigned 16-bit arithmetic
+/// Refuses B44 and B44A parts: `exr`'s B44 decoder does OpenEXR's unsigned 16-bit arithmetic
 /// with subtractions that wrap, which a build with overflow checks (tests, fuzzing, debug)
 /// turns into a panic on ordinary data. These lossy formats are meant for images to look at,
 /// not for textures read as data.
@@ -52,6 +44,14 @@ fn check_compression(header: &exr::meta::header::Header, path: &Path) -> Result<
     ))
 }
 
+/// Refuses a part whose blocks (tiles, or runs of scan lines) hold more bytes than the whole
+/// part, or than [`BLOCK_BYTES_FLOOR`] if that is more.
+///
+/// The decoder reads each block into a buffer of the size the header implies for a block
+/// before it finds out whether the file holds that many bytes, and the header's tile size is
+/// not tied to the image's: a 2.5 KB file declaring 64 × 16 449 600-pixel tiles on a 64 × 64
+/// image made it zero-fill a gigabyte. A real block is a piece of its image, so only a part
+/// smaller than one block (a tiny image in large tiles) comes near the bound.
 fn check_block_size(header: &exr::meta::header::Header, path: &Path) -> Result<(), TextureError> {
     let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
     let bytes_per_pixel = header.channels.bytes_per_pixel as u64;
