@@ -98,8 +98,10 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
     // all of it before giving up: a few faces spread over the mesh tell first. A face that
     // fails here fails the full test too.
     let mut probe_visits = 0;
+    // The faces probed are those at multiples of `stride`; 0 when there is no probe.
+    let mut stride = 0;
     if planes.len() > 4 * PROBE_FACES {
-        let stride = planes.len() / PROBE_FACES;
+        stride = planes.len() / PROBE_FACES;
         let mut probed = 0u64;
         for plane in planes.iter().step_by(stride) {
             let (passed, visits) = tree.nothing_in_front(plane, tolerance, margin);
@@ -114,14 +116,19 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
             return (false, probe_visits);
         }
     }
-    // Faces in parallel. The answer does not depend on the order: true needs every face to
-    // pass, and then the total work is the same sum whatever the order.
-    let work = AtomicU64::new(0);
-    let passed = planes.par_iter().all(|plane| {
+    // The other faces in parallel, the probe's visits already counted. The answer does not
+    // depend on the order: true needs every face to pass, and then the total work is the same
+    // sum whatever the order.
+    let work = AtomicU64::new(probe_visits);
+    let probed = |i: usize| stride != 0 && i.is_multiple_of(stride);
+    let passed = planes.par_iter().enumerate().all(|(i, plane)| {
+        if probed(i) {
+            return true;
+        }
         let (passed, visits) = tree.nothing_in_front(plane, tolerance, margin);
         passed && work.fetch_add(visits, Ordering::Relaxed) + visits <= limit
     });
-    (passed, probe_visits + work.load(Ordering::Relaxed))
+    (passed, work.load(Ordering::Relaxed))
 }
 
 /// The smallest corner of the positions' bounding box and its diagonal's length, in f64 (the
