@@ -57,6 +57,21 @@ fn random_scene(rng: &mut Pcg32, n: usize) -> Vec<[Vec3; 3]> {
     tris
 }
 
+/// `n` unit triangles facing +x at x = ratioⁱ: at exponentially growing distances, SAH splits
+/// them off about one at a time, so the tree gets deep.
+fn chain(n: i32, ratio: f32) -> Vec<[Vec3; 3]> {
+    (0..n)
+        .map(|i| {
+            let x = ratio.powi(i);
+            [
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, 1.0, 0.0),
+                Vec3::new(x, 0.0, 1.0),
+            ]
+        })
+        .collect()
+}
+
 /// Checks the leaf-ordered copies against the input, on top of `validate`.
 fn check(bvh: &Bvh, input: &[[Vec3; 3]]) {
     bvh.validate().unwrap();
@@ -308,16 +323,7 @@ fn identical_centroids_still_give_small_leaves() {
 fn deep_unbalanced_input_stays_within_the_stack() {
     // Triangles at exponentially growing distances make SAH split off one at a time; the
     // depth cap must still hold.
-    let tris: Vec<[Vec3; 3]> = (0..200)
-        .map(|i| {
-            let x = 1.2f32.powi(i);
-            [
-                Vec3::new(x, 0.0, 0.0),
-                Vec3::new(x, 1.0, 0.0),
-                Vec3::new(x, 0.0, 1.0),
-            ]
-        })
-        .collect();
+    let tris = chain(200, 1.2);
     let bvh = Bvh::build(&tris);
     check(&bvh, &tris);
     for i in [0usize, 50, 199] {
@@ -343,20 +349,10 @@ fn a_build_split_over_threads_is_the_one_threaded_build() {
     // copies), a closed sphere, and a chain that SAH splits one triangle at a time, deep enough
     // to reach the object-median splits.
     let mut rng = Pcg32::new(15, 4);
-    let chain: Vec<[Vec3; 3]> = (0..300)
-        .map(|i| {
-            let x = 1.1f32.powi(i);
-            [
-                Vec3::new(x, 0.0, 0.0),
-                Vec3::new(x, 1.0, 0.0),
-                Vec3::new(x, 0.0, 1.0),
-            ]
-        })
-        .collect();
     let inputs = [
         random_scene(&mut rng, 3000),
         icosphere(4, Vec3::ZERO, 1.0),
-        chain,
+        chain(300, 1.1),
     ];
     for tris in &inputs {
         let one = build::build_splitting_from(tris, usize::MAX).unwrap();
