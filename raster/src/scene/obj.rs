@@ -89,35 +89,14 @@ const GROUP_LIBRARY: &str = "\u{1}lucent-usemtl-names";
 /// else, where they would change a number, an index or a name that must match.
 pub fn load_obj(bytes: &[u8]) -> Result<ObjMesh, ObjError> {
     let text = utf8_lines(bytes, &["o", "g", "s"])?;
-    check_indices(&text)?;
-    // `tobj` takes a statement's argument as the line after its first space, so an indented
-    // `usemtl x` would name the group "usemtl x": statements start at their first word here.
-    let mut with_groups = format!("mtllib {GROUP_LIBRARY}\n");
-    for line in text.lines() {
-        with_groups.push_str(line.trim_start());
-        with_groups.push('\n');
-    }
-    let text = &with_groups[with_groups.find('\n').map_or(0, |i| i + 1)..];
-    let mut groups_in_text: Vec<String> = Vec::new();
-    let mut mtllibs = Vec::new();
-    for (number, line) in text.lines().enumerate() {
-        // The same split as `tobj`'s (the rest of the line after the first space, trimmed).
-        match line.split_whitespace().next() {
-            Some("usemtl") => {
-                let name = line.split_once(' ').unwrap_or_default().1.trim();
-                if !name.is_empty() && !groups_in_text.iter().any(|g| g == name) {
-                    groups_in_text.push(name.to_string());
-                }
-            }
-            Some("mtllib") => {
-                let path = line.split_once(' ').unwrap_or_default().1.trim();
-                if !path.is_empty() {
-                    mtllibs.push((number + 1, path.to_string()));
-                }
-            }
-            _ => {}
-        }
-    }
+    let statements = Statements::scan(&text);
+    check_indices(&text, statements.totals)?;
+    let Statements {
+        text: with_groups,
+        groups: groups_in_text,
+        mtllibs,
+        ..
+    } = statements;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -153,6 +132,60 @@ pub fn load_obj(bytes: &[u8]) -> Result<ObjMesh, ObjError> {
     let mut obj = merge(&models, &materials)?;
     obj.mtllibs = mtllibs;
     Ok(obj)
+}
+
+/// What one pass over an OBJ file's lines gathers for [`load_obj`].
+struct Statements {
+    /// The text as `tobj` gets it: the synthetic `mtllib` line naming the `usemtl` groups,
+    /// then each line from its first word on. (`tobj` takes a statement's argument as the line
+    /// after its first space, so an indented `usemtl x` would name the group "usemtl x".)
+    text: String,
+    /// The `usemtl` names, in order of first appearance.
+    groups: Vec<String>,
+    /// The `mtllib` statements: (1-based line, path).
+    mtllibs: Vec<(usize, String)>,
+    /// How many `v`, `vt` and `vn` statements the file has.
+    totals: [usize; 3],
+}
+
+impl Statements {
+    fn scan(text: &str) -> Statements {
+        let mut out = Statements {
+            text: String::with_capacity(text.len() + GROUP_LIBRARY.len() + 16),
+            groups: Vec::new(),
+            mtllibs: Vec::new(),
+            totals: [0; 3],
+        };
+        out.text.push_str("mtllib ");
+        out.text.push_str(GROUP_LIBRARY);
+        out.text.push('\n');
+        for (number, line) in text.lines().enumerate() {
+            let line = line.trim_start();
+            out.text.push_str(line);
+            out.text.push('\n');
+            // The same split as `tobj`'s (the rest of the line after the first space, trimmed).
+            let argument = || line.split_once(' ').unwrap_or_default().1.trim();
+            match line.split_whitespace().next() {
+                Some("v") => out.totals[0] += 1,
+                Some("vt") => out.totals[1] += 1,
+                Some("vn") => out.totals[2] += 1,
+                Some("usemtl") => {
+                    let name = argument();
+                    if !name.is_empty() && !out.groups.iter().any(|g| g == name) {
+                        out.groups.push(name.to_string());
+                    }
+                }
+                Some("mtllib") => {
+                    let path = argument();
+                    if !path.is_empty() {
+                        out.mtllibs.push((number + 1, path.to_string()));
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
+    }
 }
 
 /// The text of a file whose lines must be UTF-8, except comments and the statements in
@@ -304,17 +337,9 @@ fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh
 }
 
 /// Checks face-index ranges the way `tobj` resolves them, reporting the first bad one with its
-/// line. Counts of `v`, `vt`, `vn` so far resolve negative indices; totals bound positive ones.
-fn check_indices(text: &str) -> Result<(), ObjError> {
-    let mut totals = [0usize; 3];
-    for line in text.lines() {
-        match line.split_whitespace().next() {
-            Some("v") => totals[0] += 1,
-            Some("vt") => totals[1] += 1,
-            Some("vn") => totals[2] += 1,
-            _ => {}
-        }
-    }
+/// line. Counts of `v`, `vt`, `vn` so far resolve negative indices; the file's `totals` bound
+/// positive ones.
+fn check_indices(text: &str, totals: [usize; 3]) -> Result<(), ObjError> {
     const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
     let mut so_far = [0usize; 3];
     for (number, line) in text.lines().enumerate() {
@@ -420,6 +445,12 @@ f 1/1 2/2 3/3 4/4
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n";
         let m = parse_obj(text.as_bytes()).expect("loads");
         assert_eq!(m.triangles.len(), 1);
+        // Positive indices are bounded by the whole file's count: a face may come first.
+        let text = "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        assert_eq!(
+            parse_obj(text.as_bytes()).expect("loads").triangles.len(),
+            1
+        );
     }
 
     #[test]

@@ -61,23 +61,32 @@ pub fn drop_coincident_triangles(
 /// surface is closed and consistently wound, so its winding says inside from outside.
 pub fn is_closed_and_consistent(mesh: &Mesh) -> bool {
     let ids = position_ids(&mesh.positions);
-    // Each directed edge as its undirected key and its direction: sorted, a closed and
-    // consistently wound surface gives exactly one pair per key, one of each direction. One
-    // sort and a linear scan (a binary search per edge took a second on 2 M triangles).
-    let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(3 * mesh.triangles.len());
+    // Each edge as a key of its two ends, smaller first, filed by its direction: the surface
+    // is closed and consistently wound when the two files hold the same keys, each once (every
+    // edge used once in each direction). Two sorts of 64-bit keys: a sort of (ends, direction)
+    // tuples took twice as long on 2 M triangles, a binary search per edge a second.
+    let half = 3 * mesh.triangles.len() / 2 + 1;
+    let (mut forward, mut backward) = (Vec::with_capacity(half), Vec::with_capacity(half));
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|i| ids[i as usize]);
         if a == b || b == c || c == a {
             return false;
         }
         for (from, to) in [(a, b), (b, c), (c, a)] {
-            edges.push((from.min(to), from.max(to), from < to));
+            let key = (u64::from(from.min(to)) << 32) | u64::from(from.max(to));
+            if from < to {
+                forward.push(key);
+            } else {
+                backward.push(key);
+            }
         }
     }
-    edges.sort_unstable();
-    edges
-        .chunks(2)
-        .all(|p| p.len() == 2 && p[0].0 == p[1].0 && p[0].1 == p[1].1 && p[0].2 != p[1].2)
+    if forward.len() != backward.len() {
+        return false;
+    }
+    forward.sort_unstable();
+    backward.sort_unstable();
+    forward == backward && forward.windows(2).all(|pair| pair[0] != pair[1])
 }
 
 /// The signed volume enclosed by the triangles (positive when they wind counter-clockwise
