@@ -8,11 +8,14 @@
 //! slots:       open addressing, key → cell index (u32::MAX empty), 2× the cells
 //! tri_start:   [0, 2, 5, …]         triangles of cell c: tris[tri_start[c] .. tri_start[c + 1]],
 //! tris:        [t, t, …]            ascending
+//! block_start: [0, 1, 3, …]         runs of cell c: block_boxes[block_start[c] .. block_start[c + 1]]
+//! block_boxes: [[lo, hi], …]        the box of each run of BLOCK entries of a cell's triangles
 //! ```
 //!
 //! About 23 bytes per site (12 position, 4 order, ~7 cells and slots) plus 4 per (cell,
-//! triangle) pair, about one pair per site on a mesh with fewer triangles than samples. While
-//! the pairs are sorted by cell they are held twice, with 4 bytes per triangle.
+//! triangle) pair, about one pair per site on a mesh with fewer triangles than samples, and 24
+//! per run of up to [`BLOCK`] pairs. While the pairs are sorted by cell they are held twice,
+//! with 4 bytes per triangle.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -24,6 +27,9 @@ const AXIS_MAX: i64 = (1 << AXIS_BITS) - 1;
 const EMPTY: u32 = u32::MAX;
 /// Triangles per parallel task when registering them with the cells.
 const REGISTER_CHUNK: usize = 4096;
+/// Entries of a cell's triangle list per bounding box: a site's or a centroid's search skips
+/// a run whose box is out of reach without looking at its triangles.
+pub(super) const BLOCK: usize = 16;
 
 /// The grid (see the module documentation).
 pub(super) struct Cells {
@@ -41,6 +47,11 @@ pub(super) struct Cells {
     shift: u32,
     tri_start: Vec<u32>,
     tris: Vec<u32>,
+    /// The bounding box (lower, upper corner) of each run of [`BLOCK`] consecutive entries of
+    /// a cell's triangle list (a cell's last run may be shorter).
+    block_boxes: Vec<[Vec3; 2]>,
+    /// The runs of cell `c` are `block_boxes[block_start[c]..block_start[c + 1]]`.
+    block_start: Vec<u32>,
 }
 
 fn pack(c: [i64; 3]) -> u64 {
@@ -77,6 +88,8 @@ impl Cells {
             shift: 0,
             tri_start: Vec::new(),
             tris: Vec::new(),
+            block_boxes: Vec::new(),
+            block_start: Vec::new(),
         };
         // An indexed collect writes in place (a filtered one would gather pieces and copy
         // them, twice the memory); non-finite sites get a key above every cell's and are cut
@@ -166,6 +179,13 @@ impl Cells {
     /// The triangles registered with occupied cell `c`, ascending.
     pub(super) fn triangles_of(&self, c: usize) -> &[u32] {
         &self.tris[self.tri_start[c] as usize..self.tri_start[c + 1] as usize]
+    }
+
+    /// [`Cells::triangles_of`] in runs of [`BLOCK`], each with its bounding box.
+    pub(super) fn triangle_runs(&self, c: usize) -> impl Iterator<Item = (&[u32], &[Vec3; 2])> {
+        let boxes =
+            &self.block_boxes[self.block_start[c] as usize..self.block_start[c + 1] as usize];
+        self.triangles_of(c).chunks(BLOCK).zip(boxes)
     }
 
     fn slot(&self, key: u64) -> usize {
@@ -284,6 +304,32 @@ impl Cells {
                 next[c as usize] += 1;
             }
         }
+        // The runs' boxes. A mesh's triangles that are close in index are mostly close in
+        // space too, so the runs of an ascending list mostly have small boxes.
+        let mut runs = Vec::new();
+        let mut block_start = Vec::with_capacity(self.len() + 1);
+        block_start.push(0);
+        for c in 0..self.len() {
+            let end = start[c + 1] as usize;
+            runs.extend(
+                (start[c] as usize..end)
+                    .step_by(BLOCK)
+                    .map(|a| a..end.min(a + BLOCK)),
+            );
+            block_start.push(runs.len() as u32);
+        }
+        self.block_boxes = runs
+            .into_par_iter()
+            .map(|run| {
+                tris[run]
+                    .iter()
+                    .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], &t| {
+                        let [a, b, c] = triangles[t as usize];
+                        [lo.min(a).min(b).min(c), hi.max(a).max(b).max(c)]
+                    })
+            })
+            .collect();
+        self.block_start = block_start;
         self.tris = tris;
         self.tri_start = start;
     }

@@ -351,6 +351,24 @@ pub(super) fn box_distance2_below(p: DVec3, t: &[Vec3; 3]) -> f64 {
     // min and max are exact in f32.
     let lo = t[0].min(t[1]).min(t[2]).as_dvec3();
     let hi = t[0].max(t[1]).max(t[2]).as_dvec3();
+    box_bound(p, lo, hi)
+}
+
+/// [`box_distance2_below`] for every triangle inside the box `[lo, hi]` at once: the same bound
+/// with the box for the triangle's. It is at most the bound of each such triangle (a larger box
+/// is nearer, its slack no smaller, and every rounded step is monotone), so a limit it exceeds,
+/// each of theirs exceeds too. NaN when `p` is NaN.
+#[inline]
+pub(super) fn box_distance2_below_all(p: DVec3, lo: Vec3, hi: Vec3) -> f64 {
+    if p.is_nan() {
+        return f64::NAN;
+    }
+    box_bound(p, lo.as_dvec3(), hi.as_dvec3())
+}
+
+/// The bound of [`box_distance2_below`] from the box's corners.
+#[inline(always)]
+fn box_bound(p: DVec3, lo: DVec3, hi: DVec3) -> f64 {
     let gap = (lo - p).max(p - hi).max(DVec3::ZERO);
     let slack = ROUNDING_SLACK * p.abs().max(lo.abs()).max(hi.abs()).max_element();
     // (g − s)² ≥ (1 − ε)·g² − s²/ε for any ε > 0 (as 2gs ≤ ε·g² + s²/ε): no square root.
@@ -498,5 +516,47 @@ mod tests {
         assert!(useful > 8_000, "{useful}");
         let nan = [Vec3::NAN, Vec3::ZERO, Vec3::X];
         assert!(box_distance2_below(DVec3::splat(5.0), &nan).is_nan());
+    }
+
+    #[test]
+    fn a_run_bound_is_below_each_of_its_triangles_bounds() {
+        // Runs of 1 to 16 triangles scattered over a patch, the patch near and far from the
+        // origin and from 0 to 3 of its sizes off it: the run's bound never exceeds any of
+        // its triangles' (so skipping the run skips only triangles each test skips).
+        let mut rng = Pcg32::new(5, 11);
+        let (mut runs, mut pruned) = (0, 0);
+        for case in 0..5_000 {
+            let offset = [0.0, -1.0, 1e3, -3e4][case % 4] as f32;
+            let size = [1e-3, 0.1, 1.0][case / 4 % 3] as f32;
+            let mut corner = || {
+                Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * size
+                    + Vec3::splat(offset)
+            };
+            let tris: Vec<[Vec3; 3]> = (0..1 + case % 16)
+                .map(|_| [corner(), corner(), corner()])
+                .collect();
+            let away = [0.0, 0.5, 1.5, 3.0][case / 12 % 4] * size as f64;
+            let p = tris[0][0].as_dvec3()
+                + DVec3::new(
+                    rng.next_f32() as f64 - 0.5,
+                    rng.next_f32() as f64 - 0.5,
+                    rng.next_f32() as f64 - 0.5,
+                ) * size as f64
+                + DVec3::splat(away);
+            let lo = tris.iter().flatten().fold(Vec3::INFINITY, |m, &v| m.min(v));
+            let hi = tris
+                .iter()
+                .flatten()
+                .fold(Vec3::NEG_INFINITY, |m, &v| m.max(v));
+            let run = box_distance2_below_all(p, lo, hi);
+            for t in &tris {
+                let own = box_distance2_below(p, t);
+                assert!(run <= own, "case {case}: run {run:e} > triangle {own:e}");
+            }
+            runs += 1;
+            pruned += usize::from(run > 0.0);
+        }
+        assert!(pruned > runs / 4, "{pruned} of {runs} runs with a bound");
+        assert!(box_distance2_below_all(DVec3::NAN, Vec3::ZERO, Vec3::ONE).is_nan());
     }
 }

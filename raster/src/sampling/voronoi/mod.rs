@@ -80,8 +80,8 @@ use rayon::prelude::*;
 use super::surface::{SurfacePoint, hex_spacing, triangle_area};
 use cells::Cells;
 use clip::{
-    Frame, Neighbour, Outcome, Polygon, box_distance2_below, distance2_to_triangle,
-    nearest_on_triangle,
+    Frame, Neighbour, Outcome, Polygon, box_distance2_below, box_distance2_below_all,
+    distance2_to_triangle, nearest_on_triangle,
 };
 
 /// Grid cell edge, in hexagonal-packing spacings. A cell's 3×3×3 block guarantees every
@@ -329,7 +329,6 @@ impl Pass<'_> {
         counts: &mut [u64; 3],
     ) {
         let cells = self.cells;
-        let triangles = cells.triangles_of(c);
         for s in cells.sites_of(c) {
             let ps = cells.sites[s].as_dvec3();
             let guaranteed = cells.block_margin(ps, home, 1);
@@ -346,43 +345,49 @@ impl Pass<'_> {
             counts[2] += neighbours.iter().take_while(|n| n.0 == 0.0).count().min(1) as u64;
             // Σ a and Σ a·(c − site) over the polygons.
             let (mut area, mut first) = (0.0, DVec3::ZERO);
-            for &t in triangles {
-                let tri = &self.triangles[t as usize];
-                // Most of a grid cell's triangles are beyond the reach of each of its sites:
-                // their bounding boxes say so for a fraction of the exact test's cost.
-                if box_distance2_below(ps, tri) > self.reach2
-                    || distance2_to_triangle(ps, tri) > self.reach2
-                {
+            // Most of a grid cell's triangles are beyond the reach of each of its sites: the
+            // bounding boxes of runs of them, then of each, say so for a fraction of the exact
+            // test's cost.
+            for (run, [lo, hi]) in cells.triangle_runs(c) {
+                if box_distance2_below_all(ps, *lo, *hi) > self.reach2 {
                     continue;
                 }
-                let Some(frame) = Frame::new(tri) else {
-                    continue;
-                };
-                counts[0] += 1;
-                let mut outcome = scratch.polygon.clip_cell(
-                    &frame,
-                    ps,
-                    &cells.sites,
-                    &neighbours,
-                    sorted,
-                    guaranteed,
-                );
-                if let Outcome::NeedMore(r2) = outcome {
-                    counts[1] += 1;
-                    outcome = self.clip_wide(s, ps, &frame, r2, scratch);
-                }
-                if outcome != Outcome::Done {
-                    continue;
-                }
-                let (a, c) = scratch.polygon.moment();
-                area += a;
-                first += (frame.point(c.x, c.y) - ps) * a;
-                let mut flag = if a > 0.0 { TOUCHED } else { 0 };
-                if !self.leads_to_processing(&scratch.polygon, tri, self.reach2) {
-                    flag |= INCOMPLETE;
-                }
-                if flag != 0 {
-                    flags[t as usize].fetch_or(flag, Ordering::Relaxed);
+                for &t in run {
+                    let tri = &self.triangles[t as usize];
+                    if box_distance2_below(ps, tri) > self.reach2
+                        || distance2_to_triangle(ps, tri) > self.reach2
+                    {
+                        continue;
+                    }
+                    let Some(frame) = Frame::new(tri) else {
+                        continue;
+                    };
+                    counts[0] += 1;
+                    let mut outcome = scratch.polygon.clip_cell(
+                        &frame,
+                        ps,
+                        &cells.sites,
+                        &neighbours,
+                        sorted,
+                        guaranteed,
+                    );
+                    if let Outcome::NeedMore(r2) = outcome {
+                        counts[1] += 1;
+                        outcome = self.clip_wide(s, ps, &frame, r2, scratch);
+                    }
+                    if outcome != Outcome::Done {
+                        continue;
+                    }
+                    let (a, c) = scratch.polygon.moment();
+                    area += a;
+                    first += (frame.point(c.x, c.y) - ps) * a;
+                    let mut flag = if a > 0.0 { TOUCHED } else { 0 };
+                    if !self.leads_to_processing(&scratch.polygon, tri, self.reach2) {
+                        flag |= INCOMPLETE;
+                    }
+                    if flag != 0 {
+                        flags[t as usize].fetch_or(flag, Ordering::Relaxed);
+                    }
                 }
             }
             scratch.neighbours = neighbours;
@@ -558,19 +563,24 @@ impl Pass<'_> {
                 cells.sites_of(c).map(move |s| {
                     let p = sums[s].1.as_dvec3();
                     let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0], p);
-                    for &t in cells.triangles_of(c) {
-                        let tri = &self.triangles[t as usize];
+                    for (run, [lo, hi]) in cells.triangle_runs(c) {
                         // Not nearer than the best so far (a tie keeps the first): skipped.
-                        if box_distance2_below(p, tri) >= best.0 {
+                        if box_distance2_below_all(p, *lo, *hi) >= best.0 {
                             continue;
                         }
-                        let w = nearest_on_triangle(p, tri);
-                        let q = tri[0].as_dvec3() * w[0]
-                            + tri[1].as_dvec3() * w[1]
-                            + tri[2].as_dvec3() * w[2];
-                        let d2 = p.distance_squared(q);
-                        if d2 < best.0 {
-                            best = (d2, t, w, q);
+                        for &t in run {
+                            let tri = &self.triangles[t as usize];
+                            if box_distance2_below(p, tri) >= best.0 {
+                                continue;
+                            }
+                            let w = nearest_on_triangle(p, tri);
+                            let q = tri[0].as_dvec3() * w[0]
+                                + tri[1].as_dvec3() * w[1]
+                                + tri[2].as_dvec3() * w[2];
+                            let d2 = p.distance_squared(q);
+                            if d2 < best.0 {
+                                best = (d2, t, w, q);
+                            }
                         }
                     }
                     match best {
