@@ -303,13 +303,13 @@ impl Builder<'_> {
             });
             return Some(n / 2);
         }
-        let best = (0..3)
-            .filter(|&a| extent[a] > 0.0)
-            .filter_map(|a| self.best_plane(items, cb, a))
-            .fold(None, |best: Option<Split>, s| match best {
+        let best = self.best_planes(items, cb).into_iter().flatten().fold(
+            None,
+            |best: Option<Split>, s| match best {
                 Some(b) if b.cost <= s.cost => Some(b),
                 _ => Some(s),
-            });
+            },
+        );
         let Some(best) = best else {
             return (n > MAX_LEAF).then_some(n / 2);
         };
@@ -337,22 +337,38 @@ impl Builder<'_> {
     /// The bin of triangle `i`'s centroid along `axis`. `scale = BINS / extent`.
     #[inline]
     fn bin(&self, i: u32, cb: &Aabb, axis: usize, scale: f32) -> usize {
-        let k = ((self.centroids[i as usize][axis] - cb.min[axis]) * scale) as usize;
-        k.min(BINS - 1)
+        bin_of(self.centroids[i as usize][axis], cb.min[axis], scale)
     }
 
-    /// The cheapest of the `BINS − 1` planes on `axis` that leave both sides non-empty, priced
-    /// as `area(L)·|L| + area(R)·|R|` (the parent's area and the traversal cost are added by
-    /// the caller).
-    fn best_plane(&self, items: &[u32], cb: &Aabb, axis: usize) -> Option<Split> {
-        let scale = BINS as f32 / (cb.max[axis] - cb.min[axis]);
-        let mut counts = [0u32; BINS];
-        let mut boxes = [Aabb::EMPTY; BINS];
+    /// On each axis along which the centroids spread, the cheapest of the `BINS − 1` planes that
+    /// leave both sides non-empty, priced as `area(L)·|L| + area(R)·|R|` (the parent's area and
+    /// the traversal cost are added by the caller). The three axes are binned in one pass over
+    /// `items`, each triangle's box read once (a pass per axis read them three times).
+    fn best_planes(&self, items: &[u32], cb: &Aabb) -> [Option<Split>; 3] {
+        let extent = cb.max - cb.min;
+        let spread = [0, 1, 2].map(|a| extent[a] > 0.0);
+        let scale = [0, 1, 2].map(|a| BINS as f32 / extent[a]);
+        let mut counts = [[0u32; BINS]; 3];
+        let mut boxes = [[Aabb::EMPTY; BINS]; 3];
         for &i in items {
-            let k = self.bin(i, cb, axis, scale);
-            counts[k] += 1;
-            boxes[k] = boxes[k].union(&self.boxes[i as usize]);
+            let (b, c) = (&self.boxes[i as usize], self.centroids[i as usize]);
+            for a in 0..3 {
+                if spread[a] {
+                    let k = bin_of(c[a], cb.min[a], scale[a]);
+                    counts[a][k] += 1;
+                    boxes[a][k] = boxes[a][k].union(b);
+                }
+            }
         }
+        [0, 1, 2].map(|a| {
+            spread[a]
+                .then(|| Self::cheapest_plane(&counts[a], &boxes[a], a))
+                .flatten()
+        })
+    }
+
+    /// The cheapest plane between the bins of `axis` (see [`Builder::best_planes`]).
+    fn cheapest_plane(counts: &[u32; BINS], boxes: &[Aabb; BINS], axis: usize) -> Option<Split> {
         // right_cost[k] and right_count[k] describe bins k+1.. (the right side of plane k).
         let mut right_cost = [0.0f32; BINS];
         let mut right_count = [0u32; BINS];
@@ -378,6 +394,12 @@ impl Builder<'_> {
         }
         best
     }
+}
+
+/// The bin of coordinate `x` of a box starting at `min`, `scale = BINS / extent`.
+#[inline(always)]
+fn bin_of(x: f32, min: f32, scale: f32) -> usize {
+    (((x - min) * scale) as usize).min(BINS - 1)
 }
 
 /// Collapses the binary tree into the 4-wide one that queries traverse. Each wide node takes
