@@ -21,7 +21,10 @@
 //! itself (correct, only slower). A mesh with many faces tests [`PROBE_FACES`] of them first,
 //! evenly spread: when their visits extrapolate to well over the cap, it is given up then,
 //! not after spending the whole cap (a UV sphere of two million faces would need 1.7 times
-//! the cap). A flat mesh is recognised first, in one pass.
+//! the cap). A flat mesh is recognised first, in one pass. Before the tree is built,
+//! [`SCANNED_FACES`] faces spread over the mesh are tested against every vertex directly: a
+//! mesh that is not convex (a scan, a character) nearly always fails one of them, and then
+//! never pays for the tree.
 //!
 //! Tolerances are relative to the bounding-box diagonal of the positions ([`TOLERANCE`]), and
 //! faces whose corners lie within [`DEGENERATE`] of the diagonal of each other have no
@@ -45,6 +48,9 @@ const DEGENERATE: f64 = 4e-6;
 const WORK_LIMIT: u64 = 200_000_000;
 /// Faces a large mesh's test visits first, spread evenly over it, to estimate its whole work.
 const PROBE_FACES: usize = 1024;
+/// Faces tested against every vertex directly before the tree is built, spread evenly over
+/// the mesh (at most one more than this).
+const SCANNED_FACES: usize = 8;
 /// A mesh whose estimated work exceeds the budget by this factor is given up before the full
 /// test (the estimate from [`PROBE_FACES`] faces is within a few percent on smooth meshes).
 const PROBE_MARGIN: f64 = 1.25;
@@ -90,6 +96,13 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
     {
         return (true, 0); // flat
     }
+    // A few faces spread over the mesh, each against every vertex directly: a mesh that is not
+    // convex nearly always fails one of them, and then the tree is never built (on 2 M faces
+    // that is most of the test's cost). A face failing here fails the full test too: this is
+    // the comparison its leaves make.
+    if let Some(compared) = scanned_face_fails(&planes, &vertices, tolerance) {
+        return (false, compared);
+    }
     let Ok(tree) = VertexTree::build(vertices) else {
         return (false, 0);
     };
@@ -129,6 +142,20 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
         passed && work.fetch_add(visits, Ordering::Relaxed) + visits <= limit
     });
     (passed, work.load(Ordering::Relaxed))
+}
+
+/// Whether one of [`SCANNED_FACES`] faces spread evenly over `planes` has a vertex in front of
+/// it (farther than `tolerance`), and if so the vertex comparisons made up to that vertex. One
+/// pass over the vertices for all those faces, so that each vertex is read once.
+fn scanned_face_fails(planes: &[Plane], vertices: &[Vertex], tolerance: f64) -> Option<u64> {
+    let scanned: Vec<&Plane> = planes
+        .iter()
+        .step_by(planes.len().div_ceil(SCANNED_FACES).max(1))
+        .collect();
+    vertices
+        .iter()
+        .position(|v| scanned.iter().any(|plane| plane.distance(v.at) > tolerance))
+        .map(|k| (k as u64 + 1) * scanned.len() as u64)
 }
 
 /// The smallest corner of the positions' bounding box and its diagonal's length, in f64 (the
@@ -637,12 +664,41 @@ mod tests {
             work < probe,
             "{work} visits, a probe of {PROBE_FACES} faces needs about {probe}"
         );
-        // A mesh that fails is refused by the probe too: the sphere turned inside out.
+        // A mesh that fails is refused before the tree: the sphere turned inside out has
+        // vertices in front of the first face scanned, so its work is that scan's comparisons.
         let mut inverted = sphere.clone();
         for t in &mut inverted.triangles {
             t.swap(1, 2);
         }
         let (passed, work) = cannot_shadow_itself_within(&inverted, WORK_LIMIT);
-        assert!(!passed && work < probe, "{work} visits");
+        assert!(
+            !passed && work <= sphere.positions.len() as u64,
+            "{work} visits"
+        );
+    }
+
+    /// A bumpy sphere (not convex, its dents hidden from most faces' planes by the bumps
+    /// around them) is refused by one of the faces scanned directly, and agrees with the
+    /// definition.
+    #[test]
+    fn a_bumpy_sphere_is_refused_by_the_direct_scan() {
+        let mut bumpy = shapes::sphere(1.0, 64);
+        for p in &mut bumpy.positions {
+            let (theta, phi) = (p.z.clamp(-1.0, 1.0).acos(), p.y.atan2(p.x));
+            *p *= 1.0 + 0.03 * (6.0 * theta).sin() * (6.0 * phi).sin();
+        }
+        assert!(!cannot_shadow_itself(&bumpy));
+        assert!(!every_vertex_behind_every_face(&bumpy));
+        let scan = |mesh: &Mesh| {
+            let (origin, diagonal) = bounds(&mesh.positions).expect("vertices");
+            let planes = face_planes(mesh, origin, diagonal).unwrap();
+            let vertices = referenced_vertices(mesh, origin).unwrap();
+            scanned_face_fails(&planes, &vertices, TOLERANCE * diagonal)
+        };
+        let compared = scan(&bumpy).expect("a scanned face fails");
+        assert!(compared <= (SCANNED_FACES as u64 + 1) * bumpy.positions.len() as u64);
+        // A convex mesh passes the scan (and then the whole test).
+        assert_eq!(scan(&shapes::sphere(1.0, 64)), None);
+        assert_eq!(scan(&shapes::cuboid(Vec3::new(1.0, 2.0, 3.0))), None);
     }
 }
