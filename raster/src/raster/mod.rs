@@ -38,7 +38,7 @@ mod visibility;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
-mod testutil;
+pub(crate) mod testutil;
 
 pub use barycentric::perspective_barycentrics;
 pub use resolve::Fragment;

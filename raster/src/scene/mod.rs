@@ -27,6 +27,7 @@ pub mod mesh_file;
 mod model;
 pub mod mtl;
 pub mod obj;
+mod obj_reader;
 mod object_materials;
 mod objects;
 mod origin;

@@ -1,27 +1,25 @@
-//! Wavefront OBJ meshes, read with `tobj` (triangulated, single index), merged into one
-//! [`Mesh`] per file.
+//! Wavefront OBJ meshes (triangulated, single index), merged into one [`Mesh`] per file.
 //!
-//! Before `tobj` sees a file, a cheap pass checks every face index against the number of
-//! vertices, texture coordinates and normals defined so far (negative, relative indices) or in
-//! the whole file (positive indices). That gives errors with OBJ line numbers, and keeps
-//! absurd indices (which overflow inside `tobj`'s index arithmetic) away from it. Each
-//! triangle remembers its `usemtl` group and the `mtllib` paths are kept: the scene maps groups
-//! to its materials and may take `map_Kd` from the libraries (`objects.rs`, `mtl.rs`). Normals
-//! are kept when every vertex has one, else computed (area-weighted); UVs are kept when every
-//! vertex has them. A closed mesh wound inside out is flipped, and file normals against the
-//! winding are reported (`sanity.rs`).
+//! The statements are read in one pass (`obj_reader.rs`); every face index is checked against
+//! the number of vertices, texture coordinates and normals defined so far (negative, relative
+//! indices) or in the whole file (positive indices), and a bad one is reported with its OBJ
+//! line. Each triangle remembers its `usemtl` group and the `mtllib` paths are kept: the scene
+//! maps groups to its materials and may take `map_Kd` from the libraries (`objects.rs`,
+//! `mtl.rs`). Normals are kept when every vertex has one, else computed (area-weighted); UVs
+//! are kept when every vertex has them. A closed mesh wound inside out is flipped, and file
+//! normals against the winding are reported (`sanity.rs`).
 
 use std::borrow::Cow;
 use std::fmt;
-use std::io::BufReader;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use super::mesh::{
     drop_unused_vertices, reject_non_finite, retain_flagged, smooth_normals, unit_normal,
     validate_mesh,
 };
 use super::model::Mesh;
+use super::obj_reader::{ObjGroup, read_statements};
 use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
 
 /// Why an OBJ file could not be used.
@@ -31,7 +29,8 @@ pub struct ObjError {
     pub line: Option<usize>,
     /// What is wrong (with the parser's message, when the parser failed).
     pub message: String,
-    /// The OBJ parser's error, when it failed: returned by
+    /// The kind of syntax error, in the terms of the `tobj` crate (whose conventions the
+    /// reader follows), when a statement is malformed: returned by
     /// [`source`](std::error::Error::source).
     pub source: Option<tobj::LoadError>,
 }
@@ -73,119 +72,20 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
     load_obj(bytes).map(|obj| obj.mesh)
 }
 
-/// The `mtllib` name under which the `usemtl` names are handed to `tobj` (see [`load_obj`]).
-/// It starts with a control character, so no real file is called that.
-const GROUP_LIBRARY: &str = "\u{1}lucent-usemtl-names";
-
 /// Parses an OBJ file held in memory, keeping its `usemtl` groups and `mtllib` statements.
 ///
-/// `tobj` only reports a face's material when a loaded `.mtl` defines it, so the material
-/// libraries are not read here: instead every `usemtl` name found in the text is handed to
-/// `tobj` as one synthetic library, and each of its models then names its group. Reading the
-/// `.mtl` files is left to the scene, which knows whether it needs them (`kd = "mtl"`).
+/// The material libraries are not read here: that is left to the scene, which knows whether it
+/// needs them (`kd = "mtl"`).
 ///
 /// Bytes that are not UTF-8 are accepted in comments and in `o`, `g` and `s` statements
 /// (replaced by U+FFFD; lucent does not use those names) and rejected with their line anywhere
 /// else, where they would change a number, an index or a name that must match.
 pub fn load_obj(bytes: &[u8]) -> Result<ObjMesh, ObjError> {
     let text = utf8_lines(bytes, &["o", "g", "s"])?;
-    let statements = Statements::scan(&text);
-    check_indices(&text, statements.totals)?;
-    let Statements {
-        text: with_groups,
-        groups: groups_in_text,
-        mtllibs,
-        ..
-    } = statements;
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let mut reader = BufReader::new(with_groups.as_bytes());
-    let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |path| {
-        if path == std::path::Path::new(GROUP_LIBRARY) {
-            let library = groups_in_text
-                .iter()
-                .map(|name| tobj::Material {
-                    name: name.clone(),
-                    ..Default::default()
-                })
-                .collect::<Vec<_>>();
-            let index = groups_in_text
-                .iter()
-                .enumerate()
-                .map(|(i, name)| (name.clone(), i))
-                .collect();
-            Ok((library, index))
-        } else {
-            Ok((Vec::new(), Default::default()))
-        }
-    })
-    .map_err(|e| ObjError {
-        line: None,
-        message: format!("malformed OBJ: {e}"),
-        source: Some(e),
-    })?;
-    let materials = materials.unwrap_or_default();
-    let mut obj = merge(&models, &materials)?;
-    obj.mtllibs = mtllibs;
+    let statements = read_statements(&text)?;
+    let mut obj = merge(&statements.groups, &statements.usemtl_names)?;
+    obj.mtllibs = statements.mtllibs;
     Ok(obj)
-}
-
-/// What one pass over an OBJ file's lines gathers for [`load_obj`].
-struct Statements {
-    /// The text as `tobj` gets it: the synthetic `mtllib` line naming the `usemtl` groups,
-    /// then each line from its first word on. (`tobj` takes a statement's argument as the line
-    /// after its first space, so an indented `usemtl x` would name the group "usemtl x".)
-    text: String,
-    /// The `usemtl` names, in order of first appearance.
-    groups: Vec<String>,
-    /// The `mtllib` statements: (1-based line, path).
-    mtllibs: Vec<(usize, String)>,
-    /// How many `v`, `vt` and `vn` statements the file has.
-    totals: [usize; 3],
-}
-
-impl Statements {
-    fn scan(text: &str) -> Statements {
-        let mut out = Statements {
-            text: String::with_capacity(text.len() + GROUP_LIBRARY.len() + 16),
-            groups: Vec::new(),
-            mtllibs: Vec::new(),
-            totals: [0; 3],
-        };
-        out.text.push_str("mtllib ");
-        out.text.push_str(GROUP_LIBRARY);
-        out.text.push('\n');
-        for (number, line) in text.lines().enumerate() {
-            let line = line.trim_start();
-            out.text.push_str(line);
-            out.text.push('\n');
-            // The same split as `tobj`'s (the rest of the line after the first space, trimmed).
-            let argument = || line.split_once(' ').unwrap_or_default().1.trim();
-            match line.split_whitespace().next() {
-                Some("v") => out.totals[0] += 1,
-                Some("vt") => out.totals[1] += 1,
-                Some("vn") => out.totals[2] += 1,
-                Some("usemtl") => {
-                    let name = argument();
-                    if !name.is_empty() && !out.groups.iter().any(|g| g == name) {
-                        out.groups.push(name.to_string());
-                    }
-                }
-                Some("mtllib") => {
-                    let path = argument();
-                    if !path.is_empty() {
-                        out.mtllibs.push((number + 1, path.to_string()));
-                    }
-                }
-                _ => {}
-            }
-        }
-        out
-    }
 }
 
 /// The text of a file whose lines must be UTF-8, except comments and the statements in
@@ -228,9 +128,8 @@ pub(crate) fn utf8_lines<'b>(bytes: &'b [u8], lossy: &[&str]) -> Result<Cow<'b, 
     Ok(Cow::Owned(text))
 }
 
-/// Merges tobj's models (one per `o`/`g`/material group) into one mesh, remembering each
-/// triangle's `usemtl` group.
-fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh, ObjError> {
+/// Merges the file's groups into one mesh, remembering each triangle's `usemtl` group.
+fn merge(parts: &[ObjGroup], usemtl_names: &[String]) -> Result<ObjMesh, ObjError> {
     let fail = |message: String| ObjError {
         line: None,
         message,
@@ -242,54 +141,37 @@ fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh
     let mut groups: Vec<String> = Vec::new();
     let mut triangle_groups = Vec::new();
     let (mut all_normals, mut all_uvs) = (true, true);
-    for model in models {
-        let m = &model.mesh;
+    for part in parts {
         let base = mesh.positions.len();
-        let count = m.positions.len() / 3;
+        let count = part.positions.len();
         if base + count > u32::MAX as usize {
             return Err(fail("too many vertices".to_string()));
         }
-        let group = m
-            .material_id
-            .and_then(|id| materials.get(id))
-            .map(
-                |material| match groups.iter().position(|g| *g == material.name) {
-                    Some(i) => i as u32,
-                    None => {
-                        groups.push(material.name.clone());
-                        (groups.len() - 1) as u32
-                    }
-                },
-            );
-        mesh.positions.extend(
-            m.positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(p[0], p[1], p[2])),
-        );
-        if m.normals.len() == 3 * count {
-            normals.extend(
-                m.normals
-                    .chunks_exact(3)
-                    .map(|n| Vec3::new(n[0], n[1], n[2])),
-            );
+        // Numbered in order of first use by a group (a last, empty group included).
+        let group = part.usemtl.map(|id| {
+            let name = &usemtl_names[id as usize];
+            match groups.iter().position(|g| g == name) {
+                Some(i) => i as u32,
+                None => {
+                    groups.push(name.clone());
+                    (groups.len() - 1) as u32
+                }
+            }
+        });
+        mesh.positions.extend_from_slice(&part.positions);
+        if part.normals.len() == count {
+            normals.extend_from_slice(&part.normals);
         } else {
             all_normals = false;
         }
-        if m.texcoords.len() == 2 * count {
-            uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+        if part.uvs.len() == count {
+            uvs.extend_from_slice(&part.uvs);
         } else {
             all_uvs = false;
         }
-        for t in m.indices.chunks_exact(3) {
-            if let Some(&bad) = t.iter().find(|&&i| i as usize >= count) {
-                return Err(fail(format!(
-                    "face index {bad} out of range ({count} vertices)"
-                )));
-            }
-            mesh.triangles
-                .push([t[0], t[1], t[2]].map(|i| i + base as u32));
-            triangle_groups.push(group);
-        }
+        mesh.triangles
+            .extend(part.triangles.iter().map(|t| t.map(|i| i + base as u32)));
+        triangle_groups.extend(std::iter::repeat_n(group, part.triangles.len()));
     }
     if mesh.triangles.is_empty() {
         return Err(fail(
@@ -339,7 +221,7 @@ fn merge(models: &[tobj::Model], materials: &[tobj::Material]) -> Result<ObjMesh
 /// Checks face-index ranges the way `tobj` resolves them, reporting the first bad one with its
 /// line. Counts of `v`, `vt`, `vn` so far resolve negative indices; the file's `totals` bound
 /// positive ones.
-fn check_indices(text: &str, totals: [usize; 3]) -> Result<(), ObjError> {
+pub(super) fn check_indices(text: &str, totals: [usize; 3]) -> Result<(), ObjError> {
     const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
     let mut so_far = [0usize; 3];
     for (number, line) in text.lines().enumerate() {
@@ -391,6 +273,7 @@ fn check_indices(text: &str, totals: [usize; 3]) -> Result<(), ObjError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec2;
 
     const QUAD: &str = "\
 # a unit square in the xy plane, counter-clockwise seen from +z
