@@ -483,7 +483,10 @@ mod tests {
         let count = count as i64;
         match rng.range_i64(if noisy { 0 } else { 3 }, 40) {
             0 => "0".into(),
-            1 => (count + 1).to_string(),
+            // Beyond the count so far, and beyond any later one (a later vertex would make a
+            // forward reference, which only the reader accepts).
+            1 if rng.range_i64(0, 2) == 0 => (-count - 1).to_string(),
+            1 => "99999".into(),
             2 => "q".into(),
             _ if count == 0 => "1".into(),
             k if k % 2 == 0 => rng.range_i64(1, count + 1).to_string(),
@@ -599,7 +602,12 @@ mod tests {
                 }
             }
         }
-        out
+        // Other whitespace: Windows line ends, tabs and runs of spaces.
+        match rng.range_i64(0, 8) {
+            0 => out.replace('\n', "\r\n"),
+            1 => out.replace(' ', " \t "),
+            _ => out,
+        }
     }
 
     fn flat3(v: &[Vec3]) -> Vec<u32> {
