@@ -24,10 +24,23 @@ use crate::scene::{
 
 /// Loads the scene named on the command line, or the built-in default, printing its
 /// warnings on stderr.
-fn load(path: Option<&Path>) -> Result<Scene, String> {
-    let scene = match path {
-        Some(p) => load_scene(p).map_err(|e| e.to_string())?,
-        None => default_scene(),
+/// Loads the scene file, or the default scene. Mesh files are read with `--threads` threads
+/// when given (checked here, before any reading), else with every core.
+fn load(path: Option<&Path>, threads: Option<usize>) -> Result<Scene, String> {
+    let read = || match path {
+        Some(p) => load_scene(p).map_err(|e| e.to_string()),
+        None => Ok(default_scene()),
+    };
+    let scene = match threads {
+        Some(n) => {
+            check_threads(n)?;
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| format!("cannot start {n} threads: {e}"))?
+                .install(read)?
+        }
+        None => read()?,
     };
     for warning in &scene.warnings {
         errln!("warning: {warning}");
@@ -111,15 +124,19 @@ fn seed(seed: Option<u64>, scene: &mut Scene) -> Result<(), String> {
 
 fn threads(n: Option<usize>, scene: &mut Scene) -> Result<(), String> {
     if let Some(n) = n {
-        check(
-            n >= 1 && n as i64 <= MAX_THREADS,
-            "--threads",
-            n,
-            &format!("between 1 and {MAX_THREADS}"),
-        )?;
+        check_threads(n)?;
         scene.render.threads = Some(n);
     }
     Ok(())
+}
+
+fn check_threads(n: usize) -> Result<(), String> {
+    check(
+        n >= 1 && n as i64 <= MAX_THREADS,
+        "--threads",
+        n,
+        &format!("between 1 and {MAX_THREADS}"),
+    )
 }
 
 /// Applies the command-line overrides to the scene, validating each.
@@ -327,7 +344,7 @@ fn output_bytes(pixels: usize, output: &OutputSettings) -> u64 {
 /// `lucent render`.
 pub fn render(args: &RenderArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
-    let mut scene = load(args.scene.as_deref())?;
+    let mut scene = load(args.scene.as_deref(), args.threads)?;
     apply(args, &mut scene)?;
     if let Some(crop) = &args.crop {
         check_crop(crop, args, &scene)?;
@@ -438,7 +455,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
 
 /// `lucent bake`.
 pub fn bake(args: &BakeArgs) -> Result<(), String> {
-    let mut scene = load(args.scene.as_deref())?;
+    let mut scene = load(args.scene.as_deref(), args.threads)?;
     density(args.samples, args.spacing, args.max_samples, &mut scene)?;
     threads(args.threads, &mut scene)?;
     seed(args.seed, &mut scene)?;

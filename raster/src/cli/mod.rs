@@ -131,7 +131,8 @@ pub struct RenderArgs {
     /// Image height in pixels.
     #[arg(long, value_name = "H")]
     pub height: Option<u32>,
-    /// Worker threads (default: all cores). The image does not depend on it.
+    /// Worker threads, for reading mesh files and rendering (default: all cores). The image
+    /// does not depend on it.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
     /// Anti-aliasing: AA × AA coverage samples per pixel (1–8).
@@ -249,7 +250,7 @@ pub struct BakeArgs {
     /// Seed of the sample placement.
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Worker threads (default: all cores).
+    /// Worker threads, for reading mesh files and baking (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
     /// Print nothing but errors and warnings.

@@ -1,13 +1,13 @@
 //! Wavefront OBJ meshes (triangulated, single index), merged into one [`Mesh`] per file.
 //!
-//! The statements are read in one pass (`obj_reader.rs`); every face index is checked against
-//! the number of vertices, texture coordinates and normals defined so far (negative, relative
-//! indices) or in the whole file (positive indices), and a bad one is reported with its OBJ
-//! line. Each triangle remembers its `usemtl` group and the `mtllib` paths are kept: the scene
-//! maps groups to its materials and may take `map_Kd` from the libraries (`objects.rs`,
-//! `mtl.rs`). Normals are kept when every vertex has one, else computed (area-weighted); UVs
-//! are kept when every vertex has them. A closed mesh wound inside out is flipped, and file
-//! normals against the winding are reported (`sanity.rs`).
+//! The statements are read by `obj_reader/` (in chunks, in parallel); every face index is
+//! checked against the number of vertices, texture coordinates and normals defined so far
+//! (negative, relative indices) or in the whole file (positive indices), and a bad one is
+//! reported with its OBJ line. Each triangle remembers its `usemtl` group and the `mtllib`
+//! paths are kept: the scene maps groups to its materials and may take `map_Kd` from the
+//! libraries (`objects.rs`, `mtl.rs`). Normals are kept when every vertex has one, else
+//! computed (area-weighted); UVs are kept when every vertex has them. A closed mesh wound
+//! inside out is flipped, and file normals against the winding are reported (`sanity.rs`).
 
 use std::borrow::Cow;
 use std::fmt;

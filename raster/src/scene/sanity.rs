@@ -7,6 +7,7 @@
 //! changes, which would otherwise open every seam.
 
 use glam::{DVec3, Vec3};
+use rayon::slice::ParallelSliceMut;
 
 use super::mesh::{drop_unused_vertices, retain_flagged};
 use super::model::Mesh;
@@ -34,7 +35,8 @@ pub fn drop_coincident_triangles(
             (k, i as u32)
         })
         .collect();
-    keys.sort_unstable();
+    // In parallel: the keys are distinct (the index is one), so the order is the same.
+    keys.par_sort_unstable();
     let mut keep = vec![true; mesh.triangles.len()];
     let mut dropped = 0usize;
     for pair in keys.windows(2) {
@@ -84,8 +86,10 @@ pub fn is_closed_and_consistent(mesh: &Mesh) -> bool {
     if forward.len() != backward.len() {
         return false;
     }
-    forward.sort_unstable();
-    backward.sort_unstable();
+    rayon::join(
+        || forward.par_sort_unstable(),
+        || backward.par_sort_unstable(),
+    );
     forward == backward && forward.windows(2).all(|pair| pair[0] != pair[1])
 }
 

@@ -19,6 +19,7 @@
 use std::collections::HashMap;
 
 use glam::Vec3;
+use rayon::slice::ParallelSliceMut;
 
 use super::model::Mesh;
 
@@ -37,7 +38,8 @@ pub fn position_ids(positions: &[Vec3]) -> Vec<u32> {
         .enumerate()
         .map(|(i, p)| (position_bits(*p), i as u32))
         .collect();
-    keyed.sort_unstable();
+    // In parallel: the keys are distinct (the index is one), so the order is the same.
+    keyed.par_sort_unstable();
     let mut ids = vec![0; positions.len()];
     let mut first = 0;
     for (j, &(key, i)) in keyed.iter().enumerate() {
