@@ -139,6 +139,8 @@ fn merge(parts: &[ObjGroup], usemtl_names: &[String]) -> Result<ObjMesh, ObjErro
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
     let mut groups: Vec<String> = Vec::new();
+    // Per `usemtl` name, its index in `groups` once a group has used it.
+    let mut group_of: Vec<Option<u32>> = vec![None; usemtl_names.len()];
     let mut triangle_groups = Vec::new();
     let (mut all_normals, mut all_uvs) = (true, true);
     for part in parts {
@@ -149,14 +151,10 @@ fn merge(parts: &[ObjGroup], usemtl_names: &[String]) -> Result<ObjMesh, ObjErro
         }
         // Numbered in order of first use by a group (a last, empty group included).
         let group = part.usemtl.map(|id| {
-            let name = &usemtl_names[id as usize];
-            match groups.iter().position(|g| g == name) {
-                Some(i) => i as u32,
-                None => {
-                    groups.push(name.clone());
-                    (groups.len() - 1) as u32
-                }
-            }
+            *group_of[id as usize].get_or_insert_with(|| {
+                groups.push(usemtl_names[id as usize].clone());
+                (groups.len() - 1) as u32
+            })
         });
         mesh.positions.extend_from_slice(&part.positions);
         if part.normals.len() == count {
@@ -419,6 +417,38 @@ f 1 3 4
         let obj = load_obj(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
         assert!(obj.groups.is_empty());
         assert_eq!(obj.triangle_groups, vec![None]);
+    }
+
+    #[test]
+    fn thousands_of_materials_keep_their_order_of_first_use() {
+        let names = 3000;
+        let mut text = String::from("v 0 0 0\nv 1 0 0\n");
+        for row in 1..=2 {
+            for k in 0..names {
+                text.push_str(&format!("v {k} {row} 0\n"));
+            }
+        }
+        // A triangle per name, then one more per name in reverse order: the indices of the
+        // names stay those of their first use.
+        for k in 0..names {
+            text.push_str(&format!("usemtl m{k}\nf 1 2 {}\n", 3 + k));
+        }
+        for k in (0..names).rev() {
+            text.push_str(&format!("usemtl m{k}\nf 1 2 {}\n", 3 + names + k));
+        }
+        let obj = load_obj(text.as_bytes()).expect("loads");
+        assert_eq!(obj.groups.len(), names);
+        assert!(
+            obj.groups
+                .iter()
+                .enumerate()
+                .all(|(i, g)| *g == format!("m{i}"))
+        );
+        let want: Vec<Option<u32>> = (0..names as u32)
+            .chain((0..names as u32).rev())
+            .map(Some)
+            .collect();
+        assert_eq!(obj.triangle_groups, want);
     }
 
     #[test]

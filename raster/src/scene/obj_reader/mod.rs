@@ -27,6 +27,8 @@
 mod chunk;
 mod vertices;
 
+use std::collections::HashMap;
+
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
@@ -110,6 +112,7 @@ fn read_in_chunks(text: &str, chunk_bytes: usize) -> Result<ObjStatements, ObjEr
     let mut out = ObjStatements::default();
     let mut pending: Vec<PendingGroup> = Vec::new();
     let mut usemtl: Option<u32> = None;
+    let mut known = HashMap::new();
     let (mut group_start, mut faces_in_group) = (0, 0);
     let (mut first_line, mut first_corner) = (0, 0);
     for chunk in &chunks {
@@ -119,7 +122,7 @@ fn read_in_chunks(text: &str, chunk_bytes: usize) -> Result<ObjStatements, ObjEr
             faces_seen = event.faces_before;
             let material = match event.boundary {
                 Boundary::Object => usemtl,
-                Boundary::Usemtl(name) => Some(intern(&mut out.usemtl_names, name)),
+                Boundary::Usemtl(name) => Some(intern(&mut out.usemtl_names, &mut known, name)),
             };
             let ends = matches!(event.boundary, Boundary::Object) || material != usemtl;
             if ends && faces_in_group > 0 {
@@ -232,13 +235,13 @@ fn split_lines(text: &str, bytes: usize) -> Vec<&str> {
     parts
 }
 
-/// The index of `name` in `names`, appended if new.
-fn intern(names: &mut Vec<String>, name: &str) -> u32 {
-    let index = names.iter().position(|n| n == name).unwrap_or_else(|| {
+/// The index of `name` in `names` (whose indices `known` holds), appended if new. A map, not
+/// a search: a file may switch among thousands of materials millions of times.
+fn intern<'a>(names: &mut Vec<String>, known: &mut HashMap<&'a str, u32>, name: &'a str) -> u32 {
+    *known.entry(name).or_insert_with(|| {
         names.push(name.to_string());
-        names.len() - 1
-    });
-    index as u32
+        (names.len() - 1) as u32
+    })
 }
 
 /// The first error in the file: `malformed` (the first malformed statement, if that is what
