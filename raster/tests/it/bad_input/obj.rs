@@ -145,7 +145,7 @@ fn malformed_obj() {
         (
             "malformed number",
             b"v 0 0 0\nv 1 0 0\nv 0 1",
-            &["malformed OBJ"],
+            &["line 3: malformed OBJ: position parse error"],
         ),
         ("no faces", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n", &["no faces"]),
         ("empty file", b"", &["no faces"]),
