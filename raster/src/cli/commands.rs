@@ -23,9 +23,8 @@ use crate::scene::{
 };
 
 /// Loads the scene named on the command line, or the built-in default, printing its
-/// warnings on stderr.
-/// Loads the scene file, or the default scene. Mesh files are read with `--threads` threads
-/// when given (checked here, before any reading), else with every core.
+/// warnings on stderr. Mesh files are read with `--threads` threads when given (checked here,
+/// before any reading), else with every core.
 fn load(path: Option<&Path>, threads: Option<usize>) -> Result<Scene, String> {
     let read = || match path {
         Some(p) => load_scene(p).map_err(|e| e.to_string()),
