@@ -17,10 +17,12 @@ pub(super) struct Attributes<'a> {
 /// Which vertex each (`v`, `vt`, `vn`) triple became in the current group.
 ///
 /// Most positions appear with one (`vt`, `vn`) pair, so each has one slot, stamped with the
-/// group that filled it (no clearing between groups); other pairs go to a map.
+/// group that filled it; other pairs go to a map keyed by group as well. Nothing is cleared
+/// between groups: clearing a map costs its capacity, and a file may have a group with
+/// millions of seams followed by thousands of small groups.
 pub(super) struct FirstUse {
     slots: Vec<Slot>,
-    others: HashMap<Corner, u32>,
+    others: HashMap<(u32, Corner), u32>,
 }
 
 /// The first (`vt`, `vn`) pair seen with a position in group `group`, and its vertex.
@@ -62,7 +64,7 @@ impl FirstUse {
         if slot.vt == vt && slot.vn == vn {
             return Some(slot.vertex);
         }
-        match self.others.entry(corner) {
+        match self.others.entry((group, corner)) {
             std::collections::hash_map::Entry::Occupied(e) => Some(*e.get()),
             std::collections::hash_map::Entry::Vacant(e) => {
                 e.insert(next);
@@ -81,7 +83,6 @@ impl Attributes<'_> {
         number: u32,
         first_use: &mut FirstUse,
     ) -> ObjGroup {
-        first_use.others.clear();
         let mut out = ObjGroup {
             usemtl,
             triangles: Vec::with_capacity(corners.len() / 3),
