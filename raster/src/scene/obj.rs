@@ -217,10 +217,19 @@ fn merge(parts: &[ObjGroup], usemtl_names: &[String]) -> Result<ObjMesh, ObjErro
 }
 
 /// Checks face-index ranges the way `tobj` resolves them, reporting the first bad one with its
-/// line. Counts of `v`, `vt`, `vn` so far resolve negative indices; the file's `totals` bound
-/// positive ones.
-pub(super) fn check_indices(text: &str, totals: [usize; 3]) -> Result<(), ObjError> {
+/// line. Counts of `v`, `vt`, `vn` so far resolve negative indices; the file's totals bound
+/// positive ones. Two passes over the text: the reader calls it only to find an error's line.
+pub(super) fn check_indices(text: &str) -> Result<(), ObjError> {
     const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    let mut totals = [0usize; 3];
+    for line in text.lines() {
+        match line.split_whitespace().next() {
+            Some("v") => totals[0] += 1,
+            Some("vt") => totals[1] += 1,
+            Some("vn") => totals[2] += 1,
+            _ => {}
+        }
+    }
     let mut so_far = [0usize; 3];
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();

@@ -150,22 +150,15 @@ fn read_in_chunks(text: &str, chunk_bytes: usize) -> Result<ObjStatements, ObjEr
         usemtl,
         corners: group_start..first_corner,
     });
-    let (positions, uvs, normals, corners) =
-        concatenate(chunks).ok_or_else(|| index_error(text))?;
-    let totals = [positions.len(), uvs.len(), normals.len()];
-    if totals[0] >= MISSING as usize {
+    let (attributes, corners) = concatenate(chunks).ok_or_else(|| index_error(text))?;
+    if attributes.positions.len() >= MISSING as usize {
         return Err(ObjError {
             line: None,
             message: "too many vertices".to_string(),
             source: None,
         });
     }
-    let attributes = Attributes {
-        positions: &positions,
-        uvs: &uvs,
-        normals: &normals,
-    };
-    let mut first_use = FirstUse::new(positions.len());
+    let mut first_use = FirstUse::new(attributes.positions.len());
     for (number, group) in pending.iter().enumerate() {
         out.groups.push(attributes.group(
             group.usemtl,
@@ -179,14 +172,12 @@ fn read_in_chunks(text: &str, chunk_bytes: usize) -> Result<ObjStatements, ObjEr
 
 /// The chunks' attributes and corners joined in order, each corner resolved to indices into
 /// the whole file's lists; `None` if an index is out of range.
-#[allow(clippy::type_complexity)]
-fn concatenate(chunks: Vec<Chunk>) -> Option<(Vec<Vec3>, Vec<Vec2>, Vec<Vec3>, Vec<Corner>)> {
+fn concatenate(chunks: Vec<Chunk>) -> Option<(Attributes, Vec<Corner>)> {
     let total = |count: fn(&Chunk) -> usize| chunks.iter().map(count).sum::<usize>();
     let mut positions = Vec::with_capacity(total(|c| c.positions.len()));
     let mut uvs = Vec::with_capacity(total(|c| c.uvs.len()));
     let mut normals = Vec::with_capacity(total(|c| c.normals.len()));
     let mut corners = Vec::with_capacity(total(|c| c.corners.len()));
-    let totals = [positions.capacity(), uvs.capacity(), normals.capacity()];
     let mut largest = [0u64; 3];
     for chunk in chunks {
         let before = [positions.len(), uvs.len(), normals.len()];
@@ -210,8 +201,14 @@ fn concatenate(chunks: Vec<Chunk>) -> Option<(Vec<Vec3>, Vec<Vec2>, Vec<Vec3>, V
         uvs.extend_from_slice(&chunk.uvs);
         normals.extend_from_slice(&chunk.normals);
     }
+    let totals = [positions.len(), uvs.len(), normals.len()];
     let within = largest.iter().zip(totals).all(|(&l, t)| l <= t as u64);
-    within.then_some((positions, uvs, normals, corners))
+    let attributes = Attributes {
+        positions,
+        uvs,
+        normals,
+    };
+    within.then_some((attributes, corners))
 }
 
 /// `text` cut into runs of whole lines of about `bytes` each (the last may be shorter).
@@ -257,16 +254,7 @@ fn first_error(text: &str, malformed: Option<ObjError>) -> ObjError {
 
 /// The error for a bad face index, found again with its line by the two-pass check.
 fn index_error(text: &str) -> ObjError {
-    let mut totals = [0usize; 3];
-    for line in text.lines() {
-        match line.split_whitespace().next() {
-            Some("v") => totals[0] += 1,
-            Some("vt") => totals[1] += 1,
-            Some("vn") => totals[2] += 1,
-            _ => {}
-        }
-    }
-    super::obj::check_indices(text, totals)
+    super::obj::check_indices(text)
         .err()
         .unwrap_or_else(|| ObjError {
             line: None,

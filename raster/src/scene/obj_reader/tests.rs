@@ -10,27 +10,20 @@ const NAMES_LIBRARY: &str = "\u{1}usemtl-names";
 /// The reader's output as `tobj` gives it, after the two-pass index check lucent ran
 /// before `tobj`.
 fn oracle(text: &str) -> Result<Vec<(Option<String>, tobj::Mesh)>, ()> {
-    let mut totals = [0usize; 3];
     let mut names: Vec<String> = Vec::new();
     let mut fed = format!("mtllib {NAMES_LIBRARY}\n");
     for line in text.lines() {
         let line = line.trim_start();
         fed.push_str(line);
         fed.push('\n');
-        match line.split_whitespace().next() {
-            Some("v") => totals[0] += 1,
-            Some("vt") => totals[1] += 1,
-            Some("vn") => totals[2] += 1,
-            Some("usemtl") => {
-                let name = line.split_once(' ').unwrap_or_default().1.trim();
-                if !name.is_empty() && !names.iter().any(|n| n == name) {
-                    names.push(name.to_string());
-                }
+        if line.split_whitespace().next() == Some("usemtl") {
+            let name = line.split_once(' ').unwrap_or_default().1.trim();
+            if !name.is_empty() && !names.iter().any(|n| n == name) {
+                names.push(name.to_string());
             }
-            _ => {}
         }
     }
-    super::super::obj::check_indices(text, totals).map_err(|_| ())?;
+    super::super::obj::check_indices(text).map_err(|_| ())?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

@@ -8,10 +8,10 @@ use glam::{Vec2, Vec3};
 use super::{Corner, MISSING, ObjGroup};
 
 /// The file's vertex attributes, which every group's corners index.
-pub(super) struct Attributes<'a> {
-    pub positions: &'a [Vec3],
-    pub uvs: &'a [Vec2],
-    pub normals: &'a [Vec3],
+pub(super) struct Attributes {
+    pub positions: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    pub normals: Vec<Vec3>,
 }
 
 /// Which vertex each (`v`, `vt`, `vn`) triple became in the current group.
@@ -74,7 +74,7 @@ impl FirstUse {
     }
 }
 
-impl Attributes<'_> {
+impl Attributes {
     /// One group's vertices and triangles from its corners (three per triangle).
     pub fn group(
         &self,
