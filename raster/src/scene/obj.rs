@@ -20,6 +20,7 @@ use super::mesh::{
 };
 use super::model::Mesh;
 use super::obj_reader::{ObjGroup, read_statements};
+use super::origin::MAX_FILE_BYTES;
 use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
 
 /// Why an OBJ file could not be used.
@@ -77,10 +78,22 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
 /// The material libraries are not read here: that is left to the scene, which knows whether it
 /// needs them (`kd = "mtl"`).
 ///
+/// Text longer than [`MAX_FILE_BYTES`], the limit of any file a scene reads, is rejected.
+///
 /// Bytes that are not UTF-8 are accepted in comments and in `o`, `g` and `s` statements
 /// (replaced by U+FFFD; lucent does not use those names) and rejected with their line anywhere
 /// else, where they would change a number, an index or a name that must match.
 pub fn load_obj(bytes: &[u8]) -> Result<ObjMesh, ObjError> {
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(ObjError {
+            line: None,
+            message: format!(
+                "OBJ text is {} bytes, larger than the {MAX_FILE_BYTES}-byte limit",
+                bytes.len()
+            ),
+            source: None,
+        });
+    }
     let text = utf8_lines(bytes, &["o", "g", "s"])?;
     let statements = read_statements(&text)?;
     let mut obj = merge(&statements.groups, &statements.usemtl_names)?;
@@ -305,6 +318,18 @@ f 1/1 2/2 3/3 4/4
         for (p, t) in m.positions.iter().zip(uvs) {
             assert_eq!(Vec2::new(p.x, p.y), *t);
         }
+    }
+
+    #[test]
+    fn text_beyond_the_file_limit_is_refused_unread() {
+        // Zeroed pages are not touched until read: the check comes first.
+        let huge = vec![0u8; MAX_FILE_BYTES as usize + 1];
+        let e = parse_obj(&huge).unwrap_err();
+        assert_eq!(e.line, None);
+        assert!(
+            e.message.contains("larger than the 1073741824-byte limit"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -13,15 +13,18 @@
 use glam::{Vec2, Vec3};
 
 use super::{Corner, MISSING};
+use crate::scene::MAX_FILE_BYTES;
 
 /// Marks a corner slot counted from the chunk's start (see the module's table).
 pub(super) const RELATIVE: u32 = 1 << 31;
 /// Added to a relative slot's offset, which may be negative, to store it unsigned.
 pub(super) const BIAS: i64 = 1 << 29;
-/// More `v`, `vt` or `vn` statements than a file of at most 1 GiB can hold (each is at least
-/// eight bytes): an index beyond it is out of range whatever the counts, and an offset within it
-/// fits the relative form.
+/// More `v`, `vt` or `vn` statements than a file of at most [`MAX_FILE_BYTES`] can hold (each
+/// is at least seven bytes and a line end, like `v 0 0 0`): an index beyond it is out of range
+/// whatever the counts, and an offset within it fits the relative form.
 pub(super) const BEYOND_ANY_COUNT: u64 = 1 << 28;
+const _: () = assert!(BEYOND_ANY_COUNT > MAX_FILE_BYTES / 7);
+const _: () = assert!(BEYOND_ANY_COUNT < BIAS as u64);
 
 /// The first error in a chunk, which ends its reading.
 #[derive(Clone, Copy, Debug)]

@@ -26,6 +26,11 @@ pub(super) struct FirstUse {
 }
 
 /// The first (`vt`, `vn`) pair seen with a position in group `group`, and its vertex.
+///
+/// ```text
+///   0        4     8     12       16
+///   | group  | vt  | vn  | vertex |    one per position: 16 bytes
+/// ```
 #[derive(Clone, Copy)]
 struct Slot {
     group: u32,
@@ -33,6 +38,7 @@ struct Slot {
     vn: u32,
     vertex: u32,
 }
+const _: () = assert!(size_of::<Slot>() == 16);
 
 impl FirstUse {
     pub fn new(positions: usize) -> FirstUse {
