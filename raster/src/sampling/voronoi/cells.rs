@@ -29,7 +29,7 @@ const EMPTY: u32 = u32::MAX;
 const REGISTER_CHUNK: usize = 4096;
 /// Entries of a cell's triangle list per bounding box: a site's or a centroid's search skips
 /// a run whose box is out of reach without looking at its triangles.
-pub(super) const BLOCK: usize = 16;
+const BLOCK: usize = 16;
 
 /// The grid (see the module documentation).
 pub(super) struct Cells {
@@ -169,6 +169,20 @@ impl Cells {
             })
             // Never below the guaranteed k cells (rounding in the box).
             .max(k as f64 * self.size)
+    }
+
+    /// How far `p` lies inside the block of cells within `k` cells of `c` (per axis): every
+    /// site outside the block is at least this far from `p`. Unlike [`Cells::block_margin`],
+    /// `p` need not lie in cell `c`, and the distance is negative for a point outside the
+    /// block. (No site's coordinate is clamped: the cells are at least 1/2²⁰ of the extent.)
+    pub(super) fn inside_block(&self, p: DVec3, c: [i64; 3], k: i64) -> f64 {
+        let inside = (0..3).fold(f64::INFINITY, |m, a| {
+            let lo = self.origin[a] + (c[a] - k) as f64 * self.size;
+            let hi = self.origin[a] + (c[a] + k + 1) as f64 * self.size;
+            m.min(p[a] - lo).min(hi - p[a])
+        });
+        // Less the rounding of the block's faces.
+        inside - 1e-9 * self.size
     }
 
     /// Sorted site range of occupied cell `c`.

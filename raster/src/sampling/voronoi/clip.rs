@@ -129,16 +129,9 @@ impl Polygon {
         guaranteed: f64,
     ) -> Outcome {
         let f = frame;
-        self.len = 3;
-        (self.u[0], self.v[0]) = (0.0, 0.0);
-        (self.u[1], self.v[1]) = (f.v1.x, f.v1.y);
-        (self.u[2], self.v[2]) = (f.v2.x, f.v2.y);
-        self.label[..3].fill(TRIANGLE_EDGE);
-        let s = site - f.origin;
-        let (su, sv, h) = (s.dot(f.e1), s.dot(f.e2), s.dot(f.normal));
+        let (su, sv, h2) = self.whole(f, site);
         let (s2, g2) = (sorted * sorted, guaranteed * guaranteed);
-        let mut r2 = self.vertex_radius2(su, sv, h * h);
-        self.r2 = r2;
+        let mut r2 = self.r2;
         for &(d2, j) in neighbours {
             if d2 == 0.0 {
                 continue;
@@ -162,7 +155,7 @@ impl Polygon {
             if !self.clip(a, b, c, j) {
                 return Outcome::Empty;
             }
-            r2 = self.vertex_radius2(su, sv, h * h);
+            r2 = self.vertex_radius2(su, sv, h2);
             self.r2 = r2;
         }
         if 4.0 * r2 <= g2 {
@@ -170,6 +163,21 @@ impl Polygon {
         } else {
             Outcome::NeedMore(r2)
         }
+    }
+
+    /// Sets the polygon to the whole triangle of `frame`, as [`Polygon::clip_cell`] leaves it
+    /// when no bisector cuts it, and returns the site in the frame: `(u, v, height²)`.
+    pub(super) fn whole(&mut self, frame: &Frame, site: DVec3) -> (f64, f64, f64) {
+        let f = frame;
+        self.len = 3;
+        (self.u[0], self.v[0]) = (0.0, 0.0);
+        (self.u[1], self.v[1]) = (f.v1.x, f.v1.y);
+        (self.u[2], self.v[2]) = (f.v2.x, f.v2.y);
+        self.label[..3].fill(TRIANGLE_EDGE);
+        let s = site - f.origin;
+        let (su, sv, h) = (s.dot(f.e1), s.dot(f.e2), s.dot(f.normal));
+        self.r2 = self.vertex_radius2(su, sv, h * h);
+        (su, sv, h * h)
     }
 
     /// Largest squared 3-D distance from the site (frame coordinates `su, sv`, squared height

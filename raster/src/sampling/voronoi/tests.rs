@@ -332,3 +332,46 @@ fn thin_sheets_and_holes_keep_the_sum_exact() {
     assert!(r.stats.redone > 1, "{:?}", r.stats);
     check_sum(&tris, &r, 1e-6);
 }
+
+#[test]
+fn whole_triangles_give_the_bits_clipping_gives() {
+    // Fine meshes against few samples (most triangles lie in one cell) and a coarse one, with
+    // a few samples at the same position.
+    let fine = icosphere(5, Vec3::ZERO, 1.0);
+    let mut cases = vec![
+        (fine.clone(), poisson(&fine, 300, 1)),
+        (fine.clone(), poisson(&fine, 3000, 2)),
+        (sphere_and_plane(), poisson(&sphere_and_plane(), 500, 3)),
+    ];
+    let mut doubled = poisson(&fine, 400, 4);
+    doubled.extend_from_within(..20);
+    cases.push((fine, doubled));
+    for (tris, sites) in cases {
+        let with = areas_of_cells(&tris, &sites, true);
+        let without = areas_of_cells(&tris, &sites, false);
+        // The triangles of other sites' cells are not even looked at.
+        assert!(
+            with.stats.clipped + with.stats.whole < without.stats.clipped,
+            "{:?} {:?}",
+            with.stats,
+            without.stats
+        );
+        assert_eq!(
+            (with.stats.redone, with.stats.shared),
+            (without.stats.redone, without.stats.shared)
+        );
+        let bits = |r: &VoronoiAreas| -> Vec<u32> {
+            r.areas
+                .iter()
+                .map(|a| a.to_bits())
+                .chain(
+                    r.centroids
+                        .iter()
+                        .flat_map(|c| c.position.to_array().map(f32::to_bits)),
+                )
+                .collect()
+        };
+        assert_eq!(bits(&with), bits(&without));
+        assert_eq!(with.centroids, without.centroids);
+    }
+}
