@@ -172,7 +172,9 @@ fn shifted(mut node: BvhNode, shift: u32) -> BvhNode {
 }
 
 /// Per-triangle data the builder reads. (Tried: each triangle's box and centroid moved with it
-/// through the partitions instead of indices into these arrays: no gain on 2 M triangles.)
+/// through the partitions instead of indices into these arrays: no gain on 2 M triangles. And
+/// a split's parts given their bounds from its bins and partition instead of a pass over each:
+/// no gain on 100 k or 5 M triangles.)
 struct Builder<'a> {
     boxes: &'a [Aabb],
     centroids: &'a [Vec3],

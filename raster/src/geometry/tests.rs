@@ -343,6 +343,36 @@ fn build_is_deterministic() {
 }
 
 #[test]
+fn every_node_bounds_exactly_its_triangles() {
+    // A split hands its parts the bounds it found while binning and partitioning; they must be
+    // the tight bounds a pass over each part gives, node by node.
+    let mut rng = Pcg32::new(3, 9);
+    for tris in [
+        random_scene(&mut rng, 3000),
+        icosphere(4, Vec3::ZERO, 1.0),
+        chain(300, 1.1),
+    ] {
+        let built = build::build_splitting_from(&tris, 64).unwrap();
+        // Each node's triangles, by walking its subtree.
+        fn union(nodes: &[BvhNode], order: &[u32], tris: &[[Vec3; 3]], n: usize) -> Aabb {
+            let node = &nodes[n];
+            if node.is_leaf() {
+                let slots = node.first as usize..(node.first + node.count) as usize;
+                return order[slots].iter().fold(Aabb::EMPTY, |b, &i| {
+                    b.union(&Aabb::from_triangle(&tris[i as usize]))
+                });
+            }
+            let first = node.first as usize;
+            union(nodes, order, tris, first).union(&union(nodes, order, tris, first + 1))
+        }
+        for n in 0..built.nodes.len() {
+            let tight = union(&built.nodes, &built.order, &tris, n);
+            assert_eq!(built.nodes[n].bounds(), tight, "node {n} of {}", tris.len());
+        }
+    }
+}
+
+#[test]
 fn a_build_split_over_threads_is_the_one_threaded_build() {
     // Pieces built apart and spliced must give the one-threaded build's node array exactly,
     // however finely the tree is cut into pieces. The inputs: a random soup (with exact
