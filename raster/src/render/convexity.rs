@@ -80,16 +80,17 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
     }
     // A mesh whose test does not fit in memory is taken to shadow itself, like one whose test
     // exceeds the work limit.
-    let Ok(planes) = face_planes(mesh, origin, diagonal) else {
+    let Ok(faces) = Faces::new(mesh, origin, diagonal) else {
         return (false, 0);
     };
     let Ok(vertices) = referenced_vertices(mesh, origin) else {
         return (false, 0);
     };
     let tolerance = TOLERANCE * diagonal;
-    let Some(widest) = planes.iter().max_by(|a, b| a.area.total_cmp(&b.area)) else {
+    let Some(widest) = faces.widest else {
         return (true, 0); // no face with a plane: nothing a ray could hit but lines and points
     };
+    let widest = faces.plane(widest);
     if vertices
         .iter()
         .all(|v| widest.distance(v.at).abs() <= tolerance)
@@ -100,7 +101,7 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
     // convex nearly always fails one of them, and then the tree is never built (on 2 M faces
     // that is most of the test's cost). A face failing here fails the full test too: this is
     // the comparison its leaves make.
-    if let Some(compared) = scanned_face_fails(&planes, &vertices, tolerance) {
+    if let Some(compared) = scanned_face_fails(&faces, &vertices, tolerance) {
         return (false, compared);
     }
     let Ok(tree) = VertexTree::build(vertices) else {
@@ -113,18 +114,19 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
     let mut probe_visits = 0;
     // The faces probed are those at multiples of `stride`; 0 when there is no probe.
     let mut stride = 0;
-    if planes.len() > 4 * PROBE_FACES {
-        stride = planes.len() / PROBE_FACES;
+    let count = faces.with_plane.len();
+    if count > 4 * PROBE_FACES {
+        stride = count / PROBE_FACES;
         let mut probed = 0u64;
-        for plane in planes.iter().step_by(stride) {
-            let (passed, visits) = tree.nothing_in_front(plane, tolerance, margin);
+        for &face in faces.with_plane.iter().step_by(stride) {
+            let (passed, visits) = tree.nothing_in_front(&faces.plane(face), tolerance, margin);
             probe_visits += visits;
             probed += 1;
             if !passed {
                 return (false, probe_visits);
             }
         }
-        let estimate = probe_visits as f64 / probed as f64 * planes.len() as f64;
+        let estimate = probe_visits as f64 / probed as f64 * count as f64;
         if estimate > PROBE_MARGIN * limit as f64 {
             return (false, probe_visits);
         }
@@ -134,23 +136,26 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
     // sum whatever the order.
     let work = AtomicU64::new(probe_visits);
     let probed = |i: usize| stride != 0 && i.is_multiple_of(stride);
-    let passed = planes.par_iter().enumerate().all(|(i, plane)| {
+    let passed = faces.with_plane.par_iter().enumerate().all(|(i, &face)| {
         if probed(i) {
             return true;
         }
-        let (passed, visits) = tree.nothing_in_front(plane, tolerance, margin);
+        let (passed, visits) = tree.nothing_in_front(&faces.plane(face), tolerance, margin);
         passed && work.fetch_add(visits, Ordering::Relaxed) + visits <= limit
     });
     (passed, work.load(Ordering::Relaxed))
 }
 
-/// Whether one of [`SCANNED_FACES`] faces spread evenly over `planes` has a vertex in front of
-/// it (farther than `tolerance`), and if so the vertex comparisons made up to that vertex. One
-/// pass over the vertices for all those faces, so that each vertex is read once.
-fn scanned_face_fails(planes: &[Plane], vertices: &[Vertex], tolerance: f64) -> Option<u64> {
-    let scanned: Vec<&Plane> = planes
+/// Whether one of [`SCANNED_FACES`] faces with a plane, spread evenly over them, has a vertex
+/// in front of it (farther than `tolerance`), and if so the vertex comparisons made up to that
+/// vertex. One pass over the vertices for all those faces, so that each vertex is read once.
+fn scanned_face_fails(faces: &Faces, vertices: &[Vertex], tolerance: f64) -> Option<u64> {
+    let count = faces.with_plane.len();
+    let scanned: Vec<Plane> = faces
+        .with_plane
         .iter()
-        .step_by(planes.len().div_ceil(SCANNED_FACES).max(1))
+        .step_by(count.div_ceil(SCANNED_FACES).max(1))
+        .map(|&face| faces.plane(face))
         .collect();
     vertices
         .iter()
@@ -189,25 +194,70 @@ impl Plane {
     }
 }
 
-/// The planes of the faces whose corners are pairwise farther apart than [`DEGENERATE`] of
-/// the diagonal and whose normal is non-zero.
-fn face_planes(mesh: &Mesh, origin: DVec3, diagonal: f64) -> Result<Vec<Plane>, OutOfMemory> {
-    let apart = DEGENERATE * diagonal;
-    let mut planes = memory::with_capacity(mesh.triangles.len(), memory::TRIANGLES)?;
-    planes.extend(mesh.triangles.iter().filter_map(|t| {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
+/// The faces whose corners are pairwise farther apart than [`DEGENERATE`] of the diagonal and
+/// whose normal is non-zero: those with a plane worth testing. Each plane is computed when it
+/// is tested, not stored (56 bytes a face, 440 MB on a mesh of 7.8 M faces, most of which a
+/// large mesh's test never reaches).
+struct Faces<'m> {
+    mesh: &'m Mesh,
+    origin: DVec3,
+    apart: f64,
+    /// The faces with a plane, ascending.
+    with_plane: Vec<u32>,
+    /// The one of largest area (the last of equals), the most reliable plane.
+    widest: Option<u32>,
+}
+
+impl<'m> Faces<'m> {
+    fn new(mesh: &'m Mesh, origin: DVec3, diagonal: f64) -> Result<Self, OutOfMemory> {
+        let mut faces = Faces {
+            mesh,
+            origin,
+            apart: DEGENERATE * diagonal,
+            with_plane: memory::with_capacity(mesh.triangles.len(), memory::TRIANGLES)?,
+            widest: None,
+        };
+        let mut widest = f64::NEG_INFINITY;
+        for face in 0..mesh.triangles.len() as u32 {
+            if let Some(plane) = faces.try_plane(face) {
+                faces.with_plane.push(face);
+                if plane.area >= widest {
+                    (widest, faces.widest) = (plane.area, Some(face));
+                }
+            }
+        }
+        Ok(faces)
+    }
+
+    /// The plane of `face`, if it has one worth testing.
+    fn try_plane(&self, face: u32) -> Option<Plane> {
+        let t = self.mesh.triangles[face as usize];
+        let [a, b, c] = t.map(|i| self.mesh.positions[i as usize].as_dvec3());
+        let apart = self.apart;
         if a.distance(b) <= apart || b.distance(c) <= apart || a.distance(c) <= apart {
             return None;
         }
         let n = (b - a).cross(c - a);
         let area = n.length();
         (area > 0.0 && area.is_finite()).then(|| Plane {
-            at: a - origin,
+            at: a - self.origin,
             normal: n / area,
             area,
         })
-    }));
-    Ok(planes)
+    }
+
+    /// The plane of a face of [`Faces::with_plane`].
+    fn plane(&self, face: u32) -> Plane {
+        self.try_plane(face)
+            .expect("a face listed as having a plane has one")
+    }
+}
+
+/// Every face's plane, in face order (for the tests' references).
+#[cfg(test)]
+fn face_planes(mesh: &Mesh, origin: DVec3, diagonal: f64) -> Result<Vec<Plane>, OutOfMemory> {
+    let faces = Faces::new(mesh, origin, diagonal)?;
+    Ok(faces.with_plane.iter().map(|&f| faces.plane(f)).collect())
 }
 
 /// The positions some triangle uses, each once, relative to `origin`, with an outward
@@ -691,9 +741,9 @@ mod tests {
         assert!(!every_vertex_behind_every_face(&bumpy));
         let scan = |mesh: &Mesh| {
             let (origin, diagonal) = bounds(&mesh.positions).expect("vertices");
-            let planes = face_planes(mesh, origin, diagonal).unwrap();
+            let faces = Faces::new(mesh, origin, diagonal).unwrap();
             let vertices = referenced_vertices(mesh, origin).unwrap();
-            scanned_face_fails(&planes, &vertices, TOLERANCE * diagonal)
+            scanned_face_fails(&faces, &vertices, TOLERANCE * diagonal)
         };
         let compared = scan(&bumpy).expect("a scanned face fails");
         assert!(compared <= (SCANNED_FACES as u64 + 1) * bumpy.positions.len() as u64);
