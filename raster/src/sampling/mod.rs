@@ -25,7 +25,7 @@
 //! | `grid.rs` | tiles of cells over the candidates: neighbourhoods for parallel elimination |
 //! | `maxtree.rs` | blocked tournament tree: the heaviest candidate |
 //! | `poisson.rs` | weighted sample elimination |
-//! | `voronoi/` | per-sample areas: restricted Voronoi cells (grid, clipping, completion) |
+//! | `voronoi/` | per-sample areas: restricted Voronoi cells (grid, whole triangles, clipping, completion) |
 //! | `stratified.rs` | stratified points in the unit square |
 //! | `error.rs` | errors |
 

@@ -129,11 +129,11 @@ pub struct VoronoiAreas {
 pub struct VoronoiStats {
     /// (site, triangle) pairs clipped in the first pass.
     pub clipped: u64,
+    /// Of those, pairs whose cell needed neighbours beyond the 3×3×3 block.
+    pub widened: u64,
     /// (site, triangle) pairs of the first pass where the triangle lies wholly in the site's
     /// cell, taken without clipping.
     pub whole: u64,
-    /// Of those, pairs whose cell needed neighbours beyond the 3×3×3 block.
-    pub widened: u64,
     /// Triangles redone with a wider reach.
     pub redone: u64,
     /// Sites that share their position with another.
