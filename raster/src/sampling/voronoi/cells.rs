@@ -161,14 +161,8 @@ impl Cells {
     /// Distance from `p` (in the cell at coordinates `c`) to the boundary of the block of cells
     /// within `k` of `c`: every site closer than that to `p` is in [`Cells::gather`]'s block.
     pub(super) fn block_margin(&self, p: DVec3, c: [i64; 3], k: i64) -> f64 {
-        (0..3)
-            .fold(f64::INFINITY, |m, a| {
-                let lo = self.origin[a] + (c[a] - k) as f64 * self.size;
-                let hi = self.origin[a] + (c[a] + k + 1) as f64 * self.size;
-                m.min(p[a] - lo).min(hi - p[a])
-            })
-            // Never below the guaranteed k cells (rounding in the box).
-            .max(k as f64 * self.size)
+        // Never below the guaranteed k cells (rounding in the box).
+        self.to_block_faces(p, c, k).max(k as f64 * self.size)
     }
 
     /// How far `p` lies inside the block of cells within `k` cells of `c` (per axis): every
@@ -176,13 +170,18 @@ impl Cells {
     /// `p` need not lie in cell `c`, and the distance is negative for a point outside the
     /// block. (No site's coordinate is clamped: the cells are at least 1/2²⁰ of the extent.)
     pub(super) fn inside_block(&self, p: DVec3, c: [i64; 3], k: i64) -> f64 {
-        let inside = (0..3).fold(f64::INFINITY, |m, a| {
+        // Less the rounding of the block's faces.
+        self.to_block_faces(p, c, k) - 1e-9 * self.size
+    }
+
+    /// The signed distance from `p` to the nearest face of the block of cells within `k` of
+    /// `c`, as computed (positive inside).
+    fn to_block_faces(&self, p: DVec3, c: [i64; 3], k: i64) -> f64 {
+        (0..3).fold(f64::INFINITY, |m, a| {
             let lo = self.origin[a] + (c[a] - k) as f64 * self.size;
             let hi = self.origin[a] + (c[a] + k + 1) as f64 * self.size;
             m.min(p[a] - lo).min(hi - p[a])
-        });
-        // Less the rounding of the block's faces.
-        inside - 1e-9 * self.size
+        })
     }
 
     /// Sorted site range of occupied cell `c`.
