@@ -1,14 +1,13 @@
 //! The bounding volume hierarchy over world-space triangles, and its two queries: any hit
 //! (shadow rays) and closest hit.
 //!
-//! Layout: the binary tree the builder makes, a flat array of 32-byte [`BvhNode`]s (root at
-//! index 0, siblings adjacent); the same tree collapsed to a 4-wide one, a flat array of
-//! 128-byte [`WideNode`]s (each holding its up-to-four children's boxes), which the queries
-//! traverse; and the triangles copied into leaf order so a leaf's triangles are contiguous.
-//! Both trees have the same leaves.
+//! Layout: the binary tree the builder makes (a flat array of 32-byte [`BvhNode`]s) collapsed
+//! to a 4-wide one, a flat array of 128-byte [`WideNode`]s (each holding its up-to-four
+//! children's boxes), which the queries traverse; and the triangles copied into leaf order so
+//! a leaf's triangles are contiguous. The binary tree is dropped once collapsed: it took
+//! 32 bytes a node, 30–37 bytes a triangle, that no query reads.
 //!
 //! ```text
-//! nodes:      [ root | L | R | LL | LR | RL | RR | ... ]     (BvhNode, 32 bytes each)
 //! wide:       [ root: LL LR RL RR | LL: ... | ... ]           (WideNode, 128 bytes each)
 //! triangles:  [ tri  | tri | tri | ... ]                     ([Vec3; 3] in leaf order)
 //! ids:        [ 17   | 3   | 254 | ... ]                     (input index of each slot)
@@ -57,8 +56,8 @@ const BOX_T_SLACK: f32 = 1.0 + 1.0 / 4096.0;
 /// ```
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    /// The binary tree's nodes, root first (empty for an empty BVH).
-    pub(super) nodes: Vec<BvhNode>,
+    /// The bounds of every triangle ([`Aabb::EMPTY`] when empty).
+    pub(super) bounds: Aabb,
     /// The 4-wide tree's nodes, root first (empty for an empty BVH).
     pub(super) wide: Vec<WideNode>,
     /// The most entries the traversal stack can hold on `wide` (see `build::stack_need`):
@@ -145,7 +144,7 @@ impl Bvh {
         Ok(Bvh {
             stack_need: build::stack_need(&wide) as u32,
             wide,
-            nodes: built.nodes,
+            bounds: built.nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds),
             triangles: tris,
             ids: built.order,
             skipped: built.skipped,
@@ -174,11 +173,6 @@ impl Bvh {
         self.ids.get(slot as usize).copied()
     }
 
-    /// The binary tree's node array (root first), for inspection and statistics.
-    pub fn nodes(&self) -> &[BvhNode] {
-        &self.nodes
-    }
-
     /// The 4-wide tree's node array (root first) that the queries traverse.
     pub fn wide_nodes(&self) -> &[WideNode] {
         &self.wide
@@ -186,7 +180,7 @@ impl Bvh {
 
     /// Bounds of every triangle ([`Aabb::EMPTY`] when empty).
     pub fn bounds(&self) -> Aabb {
-        self.nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds)
+        self.bounds
     }
 
     /// The scene scale to pass to [`offset_origin`](super::offset_origin): the largest absolute
@@ -394,12 +388,14 @@ impl Bvh {
         }
     }
 
-    /// Checks every structural invariant: the node array is a binary tree rooted at 0 with
-    /// children stored after their parent, every node reachable exactly once and no deeper than
-    /// the traversal stack; every node's bounds are finite and contain its children's bounds or
-    /// its triangles' boxes; leaves hold 1 to `MAX_LEAF` triangles and together cover every
-    /// slot exactly once; every finite input triangle is referenced exactly once and every
-    /// other one is listed in [`Bvh::skipped`].
+    /// Checks every structural invariant: the triangles and their input indices (every finite
+    /// input triangle referenced exactly once, every other one listed in [`Bvh::skipped`]),
+    /// then the wide tree's (see [`WideNode`]): rooted at 0, children after their parent,
+    /// every node reachable once and shallower than [`MAX_DEPTH`] (so the traversal stack of
+    /// `3·MAX_DEPTH + 1` entries suffices) and the recorded stack need right; used lanes first,
+    /// unused lanes zero; every lane box finite and inside its parent lane's box, a leaf lane's
+    /// box containing its triangles' boxes; leaves of 1 to `MAX_LEAF` triangles that together
+    /// cover every slot exactly once; and [`Bvh::bounds`] the union of the root's lanes.
     pub fn validate(&self) -> Result<(), InvariantError> {
         let n_tris = self.triangles.len();
         ensure!(
@@ -409,9 +405,9 @@ impl Bvh {
             n_tris
         );
         ensure!(
-            self.nodes.is_empty() == (n_tris == 0),
-            "{} nodes for {} triangles",
-            self.nodes.len(),
+            self.wide.is_empty() == (n_tris == 0),
+            "{} wide nodes for {} triangles",
+            self.wide.len(),
             n_tris
         );
         // Every input triangle: referenced once, or skipped.
@@ -448,93 +444,17 @@ impl Bvh {
                 message: format!("triangle {id} is neither referenced nor skipped"),
             });
         }
-        if self.nodes.is_empty() {
-            return Ok(());
-        }
-        // Walk the tree.
-        let mut visited = vec![false; self.nodes.len()];
-        let mut covered = vec![false; n_tris];
-        let mut stack = vec![(0u32, 0u32)];
-        while let Some((index, depth)) = stack.pop() {
-            ensure!(
-                depth < MAX_DEPTH,
-                "node {index} at depth {depth} exceeds the traversal stack"
-            );
-            ensure!(!visited[index as usize], "node {index} reached twice");
-            visited[index as usize] = true;
-            let node = &self.nodes[index as usize];
-            let bounds = node.bounds();
-            ensure!(
-                bounds.is_finite() && !bounds.is_empty(),
-                "node {index} has bounds {bounds:?}"
-            );
-            if node.is_leaf() {
-                ensure!(
-                    node.count <= MAX_LEAF,
-                    "leaf {index} holds {} triangles",
-                    node.count
-                );
-                let (first, end) = (
-                    node.first as usize,
-                    node.first as usize + node.count as usize,
-                );
-                ensure!(
-                    end <= n_tris,
-                    "leaf {index} covers slots {first}..{end} of {n_tris}"
-                );
-                for (slot, tri) in self.triangles.iter().enumerate().take(end).skip(first) {
-                    ensure!(!covered[slot], "slot {slot} in two leaves");
-                    covered[slot] = true;
-                    let tb = Aabb::from_triangle(tri);
-                    ensure!(
-                        bounds.contains(&tb),
-                        "leaf {index} bounds {bounds:?} miss slot {slot} box {tb:?}"
-                    );
-                }
-            } else {
-                let left = node.first;
-                ensure!(
-                    left > index && (left as usize + 1) < self.nodes.len(),
-                    "interior node {index} has children {left}, {}",
-                    left as u64 + 1
-                );
-                for child in [left, left + 1] {
-                    let cb = self.nodes[child as usize].bounds();
-                    ensure!(
-                        bounds.contains(&cb),
-                        "node {index} bounds {bounds:?} do not contain child {child} {cb:?}"
-                    );
-                    stack.push((child, depth + 1));
-                }
-            }
-        }
-        if let Some(i) = visited.iter().position(|&v| !v) {
-            return Err(InvariantError {
-                message: format!("node {i} is unreachable"),
-            });
-        }
-        if let Some(slot) = covered.iter().position(|&c| !c) {
-            return Err(InvariantError {
-                message: format!("slot {slot} is in no leaf"),
-            });
-        }
         self.validate_wide()
     }
 
-    /// The wide tree's invariants (see [`WideNode`]): rooted at 0, children after their
-    /// parent, every node reachable once and shallower than [`MAX_DEPTH`] (so the traversal
-    /// stack of `3·MAX_DEPTH + 1` entries suffices) and the recorded stack need right; used
-    /// lanes first, unused lanes zero; every
-    /// lane box finite and inside its parent lane's box, and a leaf lane's box containing its
-    /// triangles' boxes; the leaves are exactly the binary tree's leaves.
+    /// The wide tree's part of [`Bvh::validate`].
     fn validate_wide(&self) -> Result<(), InvariantError> {
-        ensure!(
-            self.wide.is_empty() == self.nodes.is_empty(),
-            "{} wide nodes for {} binary nodes",
-            self.wide.len(),
-            self.nodes.len()
-        );
         if self.wide.is_empty() {
+            ensure!(
+                self.bounds == Aabb::EMPTY,
+                "an empty tree with bounds {:?}",
+                self.bounds
+            );
             return Ok(());
         }
         let n_tris = self.triangles.len();
@@ -611,19 +531,24 @@ impl Bvh {
             "traversal stack need {need} (recorded {}, at most {WIDE_STACK})",
             self.stack_need
         );
-        let mut binary: Vec<(u32, u32)> = self
-            .nodes
-            .iter()
-            .filter(|n| n.is_leaf())
-            .map(|n| (n.first, n.count))
-            .collect();
-        binary.sort_unstable();
-        leaves.sort_unstable();
+        let mut covered = vec![false; n_tris];
+        for (first, count) in leaves {
+            for slot in first..first + count {
+                ensure!(!covered[slot as usize], "slot {slot} in two leaves");
+                covered[slot as usize] = true;
+            }
+        }
+        if let Some(slot) = covered.iter().position(|&c| !c) {
+            return Err(InvariantError {
+                message: format!("slot {slot} is in no leaf"),
+            });
+        }
+        let root = &self.wide[0];
+        let union = (0..root.len()).fold(Aabb::EMPTY, |b, lane| b.union(&root.lane_bounds(lane)));
         ensure!(
-            leaves == binary,
-            "the wide tree's {} leaves are not the binary tree's {}",
-            leaves.len(),
-            binary.len()
+            union == self.bounds,
+            "bounds {:?} are not the root's {union:?}",
+            self.bounds
         );
         Ok(())
     }
