@@ -134,20 +134,27 @@ impl Bvh {
 
     /// [`Bvh::build`], or [`OutOfMemory`] if the allocator refuses one of its buffers.
     pub fn try_build(triangles: &[[Vec3; 3]]) -> Result<Bvh, OutOfMemory> {
-        let built = build::build(triangles)?;
+        let build::Built {
+            nodes,
+            order,
+            skipped,
+        } = build::build(triangles)?;
+        // Collapsed and freed before the triangles are copied: the two never live together.
+        let wide = build::collapse(&nodes)?;
+        let bounds = nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds);
+        drop(nodes);
         let tris = memory::collect(
-            built.order.len(),
-            built.order.iter().map(|&i| triangles[i as usize]),
+            order.len(),
+            order.iter().map(|&i| triangles[i as usize]),
             memory::TRIANGLES,
         )?;
-        let wide = build::collapse(&built.nodes)?;
         Ok(Bvh {
             stack_need: build::stack_need(&wide) as u32,
             wide,
-            bounds: built.nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds),
+            bounds,
             triangles: tris,
-            ids: built.order,
-            skipped: built.skipped,
+            ids: order,
+            skipped,
             source_len: triangles.len().min(MAX_TRIANGLES) as u32,
         })
     }
