@@ -4,8 +4,8 @@
 //! Layout: the binary tree the builder makes (a flat array of 32-byte [`BvhNode`]s) collapsed
 //! to a 4-wide one, a flat array of 128-byte [`WideNode`]s (each holding its up-to-four
 //! children's boxes), which the queries traverse; and the triangles copied into leaf order so
-//! a leaf's triangles are contiguous. The binary tree is dropped once collapsed: it took
-//! 32 bytes a node, 30–37 bytes a triangle, that no query reads.
+//! a leaf's triangles are contiguous. The binary tree is freed once collapsed, since no query
+//! reads it (32 bytes a node, 30–37 bytes a triangle).
 //!
 //! ```text
 //! wide:       [ root: LL LR RL RR | LL: ... | ... ]           (WideNode, 128 bytes each)
@@ -139,7 +139,8 @@ impl Bvh {
             order,
             skipped,
         } = build::build(triangles)?;
-        // Collapsed and freed before the triangles are copied: the two never live together.
+        // The binary tree is collapsed and freed before the triangles are copied, so that the
+        // two are never held at once (this is where the preparation's memory peaks).
         let wide = build::collapse(&nodes)?;
         let bounds = nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds);
         drop(nodes);
@@ -398,7 +399,7 @@ impl Bvh {
     /// Checks every structural invariant: the triangles and their input indices (every finite
     /// input triangle referenced exactly once, every other one listed in [`Bvh::skipped`]),
     /// then the wide tree's (see [`WideNode`]): rooted at 0, children after their parent,
-    /// every node reachable once and shallower than [`MAX_DEPTH`] (so the traversal stack of
+    /// every node reachable once and shallower than `MAX_DEPTH` (so the traversal stack of
     /// `3·MAX_DEPTH + 1` entries suffices) and the recorded stack need right; used lanes first,
     /// unused lanes zero; every lane box finite and inside its parent lane's box, a leaf lane's
     /// box containing its triangles' boxes; leaves of 1 to `MAX_LEAF` triangles that together

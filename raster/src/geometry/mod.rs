@@ -30,7 +30,7 @@ pub mod shapes;
 
 pub use aabb::Aabb;
 pub use bvh::{Bvh, InvariantError, ShadowHint};
-pub use node::{BvhNode, WideNode};
+pub use node::WideNode;
 pub use ray::{Hit, OFFSET_RELATIVE, Ray, offset_origin};
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::node::BvhNode;
 use super::shapes::{cube, grid, icosphere};
 use super::*;
 use crate::sampling::rng::Pcg32;

@@ -98,7 +98,7 @@ impl SceneOrigin {
 static FILES_READ: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// The files the scene loader has read so far in this process, as canonical paths (see
-/// [`read_limited`]): what a command must not overwrite.
+/// `read_limited`): what a command must not overwrite.
 pub fn files_read() -> Vec<PathBuf> {
     FILES_READ.lock().map(|f| f.clone()).unwrap_or_default()
 }
