@@ -66,7 +66,8 @@ pub fn is_closed_and_consistent(mesh: &Mesh) -> bool {
     // Each edge as a key of its two ends, smaller first, filed by its direction: the surface
     // is closed and consistently wound when the two files hold the same keys, each once (every
     // edge used once in each direction). Two sorts of 64-bit keys: a sort of (ends, direction)
-    // tuples took twice as long on 2 M triangles, a binary search per edge a second.
+    // tuples took twice as long on 2 M triangles, a binary search per edge a second, and an
+    // LSD radix sort (a byte a pass, constant bytes skipped) about 20% longer than this one.
     let half = 3 * mesh.triangles.len() / 2 + 1;
     let (mut forward, mut backward) = (Vec::with_capacity(half), Vec::with_capacity(half));
     for t in &mesh.triangles {
