@@ -56,8 +56,8 @@ pub const READ_IMAGE: Buffer = Buffer {
 
 /// Peak bytes per triangle from the flattened scene to the placed samples: the shadow BVHs,
 /// the sampler's tiles and the samples' cells. Measured (peak resident set of a sphere of
-/// 1024 segments, 1 M triangles, and of a 7.8 M-triangle OBJ sphere): 226 and 217 bytes, the
-/// mesh itself included.
+/// 1024 segments, 1 M triangles, and of a 7.8 M-triangle OBJ sphere): 239 and 211–218
+/// bytes, the mesh itself included.
 pub const PEAK_BYTES_PER_TRIANGLE: u64 = 320;
 
 /// The allocator refused a buffer.
