@@ -467,7 +467,7 @@ impl Bvh {
         }
         let n_tris = self.triangles.len();
         let mut visited = vec![false; self.wide.len()];
-        let mut leaves = Vec::new();
+        let mut covered = vec![false; n_tris];
         let mut stack: Vec<(u32, u32, Option<Aabb>)> = vec![(0, 0, None)];
         while let Some((index, depth, parent)) = stack.pop() {
             ensure!(
@@ -512,13 +512,14 @@ impl Bvh {
                         "wide node {index} lane {lane} covers slots {first}..{end} of {n_tris}"
                     );
                     for (slot, tri) in self.triangles.iter().enumerate().take(end).skip(first) {
+                        ensure!(!covered[slot], "slot {slot} in two leaves");
+                        covered[slot] = true;
                         let tb = Aabb::from_triangle(tri);
                         ensure!(
                             bounds.contains(&tb),
                             "wide node {index} lane {lane} bounds {bounds:?} miss slot {slot} box {tb:?}"
                         );
                     }
-                    leaves.push((child, count as u32));
                 } else {
                     ensure!(
                         child > index && (child as usize) < self.wide.len(),
@@ -539,13 +540,6 @@ impl Bvh {
             "traversal stack need {need} (recorded {}, at most {WIDE_STACK})",
             self.stack_need
         );
-        let mut covered = vec![false; n_tris];
-        for (first, count) in leaves {
-            for slot in first..first + count {
-                ensure!(!covered[slot as usize], "slot {slot} in two leaves");
-                covered[slot as usize] = true;
-            }
-        }
         if let Some(slot) = covered.iter().position(|&c| !c) {
             return Err(InvariantError {
                 message: format!("slot {slot} is in no leaf"),
