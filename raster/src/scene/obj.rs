@@ -21,7 +21,9 @@ use super::mesh::{
 use super::model::Mesh;
 use super::obj_reader::{ObjGroup, read_statements};
 use super::origin::MAX_FILE_BYTES;
-use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
+use super::sanity::{
+    PositionIds, drop_coincident_triangles, normals_against_winding, orient_outward,
+};
 
 /// Why an OBJ file could not be used.
 #[derive(Clone, Debug, PartialEq)]
@@ -197,10 +199,12 @@ fn merge(parts: &[ObjGroup], usemtl_names: &[String]) -> Result<ObjMesh, ObjErro
     }
     reject_non_finite(&mesh).map_err(fail)?;
     // Before the winding is checked: copies make a closed surface look open.
-    let mut warnings: Vec<String> =
-        drop_coincident_triangles(&mut mesh, |keep| retain_flagged(&mut triangle_groups, keep))
-            .into_iter()
-            .collect();
+    let mut ids = PositionIds::default();
+    let mut warnings: Vec<String> = drop_coincident_triangles(&mut mesh, &mut ids, |keep| {
+        retain_flagged(&mut triangle_groups, keep)
+    })
+    .into_iter()
+    .collect();
     drop_unused_vertices(&mut mesh);
     // File normals are only trusted when every vertex has a usable one.
     let units: Option<Vec<Vec3>> = (!mesh.normals.is_empty())
@@ -213,10 +217,10 @@ fn merge(parts: &[ObjGroup], usemtl_names: &[String]) -> Result<ObjMesh, ObjErro
         .flatten();
     if let Some(units) = units {
         mesh.normals = units;
-        warnings.extend(orient_outward(&mut mesh, true));
+        warnings.extend(orient_outward(&mut mesh, true, &mut ids));
         warnings.extend(normals_against_winding(&mesh));
     } else {
-        warnings.extend(orient_outward(&mut mesh, false));
+        warnings.extend(orient_outward(&mut mesh, false, &mut ids));
         mesh.normals = smooth_normals(&mesh.positions, &mesh.triangles);
     }
     validate_mesh(&mesh).map_err(fail)?;

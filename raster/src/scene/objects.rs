@@ -18,7 +18,9 @@ use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialRef, MaterialTable, ObjGroups, split_by_material};
 use super::origin::SceneOrigin;
-use super::sanity::{drop_coincident_triangles, normals_against_winding, orient_outward};
+use super::sanity::{
+    PositionIds, drop_coincident_triangles, normals_against_winding, orient_outward,
+};
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
 use super::weld::{MAX_CREASE_DEGREES, weld_normals};
 
@@ -147,12 +149,13 @@ pub(crate) fn build_object(
                         gltf.mesh.triangles.len(),
                     ));
                     let mut mesh = gltf.mesh;
-                    let copies = drop_coincident_triangles(&mut mesh, |keep| {
+                    let mut ids = PositionIds::default();
+                    let copies = drop_coincident_triangles(&mut mesh, &mut ids, |keep| {
                         if let Some(g) = groups.as_mut() {
                             retain_flagged(&mut g.triangle_groups, keep);
                         }
                     });
-                    let flipped = orient_outward(&mut mesh, true);
+                    let flipped = orient_outward(&mut mesh, true, &mut ids);
                     let against = normals_against_winding(&mesh);
                     (
                         mesh,
@@ -165,8 +168,9 @@ pub(crate) fn build_object(
                     // computed from the winding: either way they follow the flip when they
                     // agreed with the inverted winding. Copies go first: they make a closed
                     // surface look open.
-                    let copies = drop_coincident_triangles(&mut mesh, |_| {});
-                    let flipped = orient_outward(&mut mesh, true);
+                    let mut ids = PositionIds::default();
+                    let copies = drop_coincident_triangles(&mut mesh, &mut ids, |_| {});
+                    let flipped = orient_outward(&mut mesh, true, &mut ids);
                     let against = normals_against_winding(&mesh);
                     (
                         mesh,

@@ -13,6 +13,32 @@ use super::mesh::{drop_unused_vertices, retain_flagged};
 use super::model::Mesh;
 use super::weld::position_ids;
 
+/// A mesh's [`position_ids`], computed by the first check that needs them and shared by the
+/// checks after it (on a mesh of millions of vertices each computation sorts them all). They
+/// are computed again when the vertex count changes (dropping vertices renumbers them);
+/// whoever moves a vertex in place calls [`PositionIds::forget`].
+#[derive(Debug, Default)]
+pub struct PositionIds(Option<Vec<u32>>);
+
+impl PositionIds {
+    /// The ids of `mesh`'s vertices.
+    fn of(&mut self, mesh: &Mesh) -> &[u32] {
+        if self
+            .0
+            .as_ref()
+            .is_none_or(|ids| ids.len() != mesh.positions.len())
+        {
+            self.0 = Some(position_ids(&mesh.positions));
+        }
+        self.0.as_deref().unwrap_or_default()
+    }
+
+    /// Forgets the ids: the positions changed.
+    pub fn forget(&mut self) {
+        self.0 = None;
+    }
+}
+
 /// Drops every triangle whose three corners (by position, in any order or winding) are those
 /// of an earlier triangle, and says how many. Such copies lay the same surface twice: the
 /// irradiance samples would be placed on it as on a surface that much larger, then thinned
@@ -22,15 +48,16 @@ use super::weld::position_ids;
 /// material groups) stays aligned.
 pub fn drop_coincident_triangles(
     mesh: &mut Mesh,
+    ids: &mut PositionIds,
     keep_with: impl FnOnce(&[bool]),
 ) -> Option<String> {
-    let ids = position_ids(&mesh.positions);
+    let ids_now = ids.of(mesh);
     let mut keys: Vec<([u32; 3], u32)> = mesh
         .triangles
         .iter()
         .enumerate()
         .map(|(i, t)| {
-            let mut k = t.map(|v| ids[v as usize]);
+            let mut k = t.map(|v| ids_now[v as usize]);
             k.sort_unstable();
             (k, i as u32)
         })
@@ -53,6 +80,7 @@ pub fn drop_coincident_triangles(
     let total = mesh.triangles.len();
     retain_flagged(&mut mesh.triangles, &keep);
     drop_unused_vertices(mesh);
+    ids.forget();
     Some(format!(
         "{dropped} of its {total} triangles repeat the corners of another (coincident copies); \
          they were dropped"
@@ -61,8 +89,8 @@ pub fn drop_coincident_triangles(
 
 /// Whether every edge of the mesh (by position) is used exactly once in each direction: the
 /// surface is closed and consistently wound, so its winding says inside from outside.
-pub fn is_closed_and_consistent(mesh: &Mesh) -> bool {
-    let ids = position_ids(&mesh.positions);
+pub fn is_closed_and_consistent(mesh: &Mesh, ids: &mut PositionIds) -> bool {
+    let ids = ids.of(mesh);
     // Each edge as a key of its two ends, smaller first, filed by its direction: the surface
     // is closed and consistently wound when the two files hold the same keys, each once (every
     // edge used once in each direction). Two sorts of 64-bit keys: a sort of (ends, direction)
@@ -118,8 +146,12 @@ pub fn signed_volume(mesh: &Mesh) -> f64 {
 /// clockwise seen from outside), and says so. With `file_normals`, the vertex normals came
 /// from the file: they are negated too when they agreed with the inverted winding (they
 /// described the same inside-out surface), and kept when they already pointed out.
-pub fn orient_outward(mesh: &mut Mesh, file_normals: bool) -> Option<String> {
-    if !is_closed_and_consistent(mesh) {
+pub fn orient_outward(
+    mesh: &mut Mesh,
+    file_normals: bool,
+    ids: &mut PositionIds,
+) -> Option<String> {
+    if !is_closed_and_consistent(mesh, ids) {
         return None;
     }
     let volume = signed_volume(mesh);
@@ -213,8 +245,10 @@ mod tests {
         m.triangles.push([0, 1, 6]);
         let tags: Vec<usize> = (0..m.triangles.len()).collect();
         let mut kept_tags = tags.clone();
-        let w = drop_coincident_triangles(&mut m, |keep| retain_flagged(&mut kept_tags, keep))
-            .expect("copies found");
+        let w = drop_coincident_triangles(&mut m, &mut PositionIds::default(), |keep| {
+            retain_flagged(&mut kept_tags, keep)
+        })
+        .expect("copies found");
         assert!(
             w.starts_with("18 of its 31 triangles repeat the corners"),
             "{w}"
@@ -224,7 +258,7 @@ mod tests {
         assert_eq!(m.positions, good.positions);
         assert_eq!(m.triangles[12], [0, 1, 6]);
         assert_eq!(
-            drop_coincident_triangles(&mut m, |_| panic!("no copies")),
+            drop_coincident_triangles(&mut m, &mut PositionIds::default(), |_| panic!("no copies")),
             None
         );
     }
@@ -291,7 +325,7 @@ mod tests {
             }
             let expected = closed_and_consistent_oracle(&m);
             assert_eq!(
-                is_closed_and_consistent(&m),
+                is_closed_and_consistent(&m, &mut PositionIds::default()),
                 expected,
                 "round {round}: {m:?}"
             );
@@ -307,7 +341,7 @@ mod tests {
     #[test]
     fn volume_of_a_box_is_its_product() {
         let b = shapes::cuboid(Vec3::new(1.0, 2.0, 3.0));
-        assert!(is_closed_and_consistent(&b));
+        assert!(is_closed_and_consistent(&b, &mut PositionIds::default()));
         assert!(
             (signed_volume(&b) - 6.0).abs() < 1e-9,
             "{}",
@@ -319,24 +353,77 @@ mod tests {
     #[test]
     fn an_inside_out_sphere_is_flipped_once() {
         let good = seamless_sphere(1.0, 24);
-        assert!(is_closed_and_consistent(&good));
+        assert!(is_closed_and_consistent(&good, &mut PositionIds::default()));
         let mut m = inverted(good.clone());
         m.normals = m.normals.iter().map(|n| -*n).collect();
-        let w = orient_outward(&mut m, true).expect("flipped");
+        let w = orient_outward(&mut m, true, &mut PositionIds::default()).expect("flipped");
         assert!(w.contains("inside out") && w.contains("normals"), "{w}");
         assert_eq!(m.triangles, good.triangles);
         assert_eq!(m.normals, good.normals);
         assert!(signed_volume(&m) > 0.0);
         // Outward already: nothing to say, nothing changed.
-        assert_eq!(orient_outward(&mut m, true), None);
+        assert_eq!(
+            orient_outward(&mut m, true, &mut PositionIds::default()),
+            None
+        );
         assert_eq!(m.triangles, good.triangles);
+    }
+
+    /// One `PositionIds` through the checks of a load: reused while the vertices stay, made
+    /// again once dropping copies renumbers them (stale ids would index past the vertices or
+    /// join the wrong corners).
+    #[test]
+    fn position_ids_are_shared_until_the_vertices_change() {
+        let good = seamless_sphere(1.0, 24);
+        let corners = |m: &Mesh| -> Vec<[Vec3; 3]> {
+            m.triangles
+                .iter()
+                .map(|t| t.map(|i| m.positions[i as usize]))
+                .collect()
+        };
+        // Inside out, with copies of every third triangle on vertices of their own.
+        let mut m = inverted(good.clone());
+        let n = m.positions.len() as u32;
+        m.positions.extend_from_within(..);
+        m.normals.extend_from_within(..);
+        let copies: Vec<[u32; 3]> = m
+            .triangles
+            .iter()
+            .step_by(3)
+            .map(|t| t.map(|v| v + n))
+            .collect();
+        m.triangles.extend(copies);
+        let mut ids = PositionIds::default();
+        assert!(drop_coincident_triangles(&mut m, &mut ids, |_| {}).is_some());
+        assert!(
+            m.positions.len() <= n as usize,
+            "the copies' vertices are dropped"
+        );
+        assert!(orient_outward(&mut m, false, &mut ids).is_some());
+        assert_eq!(corners(&m), corners(&good));
+        // No copies: the ids made for the first check serve the second.
+        let mut m = inverted(good.clone());
+        let mut ids = PositionIds::default();
+        assert_eq!(drop_coincident_triangles(&mut m, &mut ids, |_| {}), None);
+        assert!(ids.0.is_some());
+        assert!(orient_outward(&mut m, false, &mut ids).is_some());
+        assert_eq!(corners(&m), corners(&good));
+        // Vertices moved in place need `forget`: with two moved onto a third, the old ids
+        // still say closed, fresh ones that three triangles have collapsed.
+        assert!(is_closed_and_consistent(&m, &mut ids));
+        let [a, b, c] = m.triangles[40];
+        m.positions[b as usize] = m.positions[a as usize];
+        m.positions[c as usize] = m.positions[a as usize];
+        assert!(is_closed_and_consistent(&m, &mut ids), "stale ids");
+        ids.forget();
+        assert!(!is_closed_and_consistent(&m, &mut ids));
     }
 
     #[test]
     fn outward_file_normals_survive_a_flip() {
         let good = seamless_sphere(1.0, 16);
         let mut m = inverted(good.clone());
-        let w = orient_outward(&mut m, true).expect("flipped");
+        let w = orient_outward(&mut m, true, &mut PositionIds::default()).expect("flipped");
         assert!(!w.contains("normals"), "{w}");
         assert_eq!(m.normals, good.normals);
     }
@@ -344,14 +431,20 @@ mod tests {
     #[test]
     fn open_meshes_are_left_alone() {
         let mut plane = inverted(shapes::plane(glam::Vec2::ONE));
-        assert!(!is_closed_and_consistent(&plane));
+        assert!(!is_closed_and_consistent(
+            &plane,
+            &mut PositionIds::default()
+        ));
         let before = plane.triangles.clone();
-        assert_eq!(orient_outward(&mut plane, false), None);
+        assert_eq!(
+            orient_outward(&mut plane, false, &mut PositionIds::default()),
+            None
+        );
         assert_eq!(plane.triangles, before);
         // A sphere with one triangle wound the other way is not consistent.
         let mut m = seamless_sphere(1.0, 8);
         m.triangles[3].swap(1, 2);
-        assert!(!is_closed_and_consistent(&m));
+        assert!(!is_closed_and_consistent(&m, &mut PositionIds::default()));
     }
 
     #[test]
