@@ -5,6 +5,7 @@ use std::error::Error;
 use std::fmt;
 
 use glam::{Mat4, Vec3, Vec4};
+use rayon::prelude::*;
 
 use super::clip::clip_and_project;
 use super::fixed::{Grid, MAX_GRID_AXIS};
@@ -253,6 +254,14 @@ impl VisibilityBuffer {
     ///
     /// Triangles with an out-of-range index are skipped (and keep their id slot); drawing stops
     /// before an id would reach [`EMPTY`].
+    ///
+    /// A mesh of at least 65 536 triangles a thread is drawn on the rayon threads, each taking
+    /// a contiguous run of triangles into a buffer of its own (the first thread into this one),
+    /// the runs' buffers then merged in id order. The buffer is the one-threaded draw's, bit for
+    /// bit: a sub-sample keeps the first triangle in id order at the least depth drawn there,
+    /// whether one thread finds it or the merge does (a later run's depth replaces an earlier
+    /// one's only where strictly less, as within a run). The extra buffers take at most 256 MB
+    /// (8 bytes a sub-sample each); a larger image is drawn in fewer runs.
     pub fn rasterize_mesh(
         &mut self,
         view_proj: Mat4,
@@ -260,8 +269,75 @@ impl VisibilityBuffer {
         triangles: &[[u32; 3]],
         first_id: u32,
     ) {
+        let runs = rayon::current_num_threads()
+            .min(triangles.len() / PARALLEL_MIN_TRIANGLES)
+            .min(self.runs_within(PARALLEL_MAX_BYTES));
+        self.draw_in_runs(view_proj, positions, triangles, first_id, runs);
+    }
+
+    /// [`VisibilityBuffer::rasterize_mesh`] in `runs` contiguous runs of triangles (one thread
+    /// each at most; fewer than two draw on this thread).
+    fn draw_in_runs(
+        &mut self,
+        view_proj: Mat4,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        first_id: u32,
+        runs: usize,
+    ) {
+        if runs < 2 || triangles.is_empty() {
+            self.draw_run(view_proj, positions, triangles, first_id, 0);
+            return;
+        }
+        // The other runs' buffers; if one cannot be had, the mesh is drawn on one thread.
+        let Ok(mut others) = (1..runs)
+            .map(|_| VisibilityBuffer::new(self.width, self.height, self.aa))
+            .collect::<Result<Vec<_>, _>>()
+        else {
+            self.draw_run(view_proj, positions, triangles, first_id, 0);
+            return;
+        };
+        let per_run = triangles.len().div_ceil(runs);
+        {
+            let mut buffers: Vec<&mut VisibilityBuffer> = Vec::with_capacity(runs);
+            buffers.push(&mut *self);
+            buffers.extend(others.iter_mut());
+            buffers
+                .par_iter_mut()
+                .zip(triangles.par_chunks(per_run))
+                .enumerate()
+                .for_each(|(run, (buffer, chunk))| {
+                    buffer.draw_run(view_proj, positions, chunk, first_id, run * per_run);
+                });
+        }
+        for later in &others {
+            self.merge_later(later);
+        }
+    }
+
+    /// How many runs [`VisibilityBuffer::rasterize_mesh`] may draw at once when the buffers of
+    /// all but the first take at most `bytes`.
+    fn runs_within(&self, bytes: u64) -> usize {
+        let per_buffer = (self.depth.len() as u64 * 8).max(1);
+        (bytes / per_buffer)
+            .saturating_add(1)
+            .min(usize::MAX as u64) as usize
+    }
+
+    /// Draws `triangles`, the mesh's from index `offset` on (ids `first_id + offset + k`).
+    fn draw_run(
+        &mut self,
+        view_proj: Mat4,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        first_id: u32,
+        offset: usize,
+    ) {
         for (k, tri) in triangles.iter().enumerate() {
-            let Some(id) = u32::try_from(k).ok().and_then(|k| first_id.checked_add(k)) else {
+            let Some(id) = u32::try_from(offset + k)
+                .ok()
+                .and_then(|k| first_id.checked_add(k))
+            else {
                 return;
             };
             let corner = |i: u32| positions.get(i as usize).map(|p| view_proj * p.extend(1.0));
@@ -270,7 +346,27 @@ impl VisibilityBuffer {
             }
         }
     }
+
+    /// Takes `later`'s sub-samples where they are strictly nearer: `later` holds triangles
+    /// drawn after every one of this buffer's (the same size).
+    fn merge_later(&mut self, later: &VisibilityBuffer) {
+        let pairs = self.depth.iter_mut().zip(&mut self.triangle);
+        for ((depth, id), (&later_depth, &later_id)) in
+            pairs.zip(later.depth.iter().zip(&later.triangle))
+        {
+            if later_depth < *depth {
+                *depth = later_depth;
+                *id = later_id;
+            }
+        }
+    }
 }
+
+/// Meshes with at least this many triangles per thread are drawn in parallel (below it, the
+/// extra buffers cost more than the threads save).
+const PARALLEL_MIN_TRIANGLES: usize = 1 << 16;
+/// Most bytes the extra buffers of a parallel draw may take (8 bytes a sub-sample each).
+const PARALLEL_MAX_BYTES: u64 = 256 << 20;
 
 /// Lanes per chunk of [`depth_test_span`]: eight `f32` fill one AVX register or two SSE ones.
 const LANES: usize = 8;
@@ -474,6 +570,57 @@ mod tests {
                     (want_d.to_bits(), want_t),
                     "len {len} k {k}"
                 );
+            }
+        }
+    }
+
+    /// A mesh drawn in runs, each into a buffer of its own, then merged, gives the buffer of
+    /// one run to the bit: ties in depth (copies of triangles, a shared plane) go to the lowest
+    /// id, triangles crossing the eye plane and bad indices are handled as one run handles
+    /// them, and ids stop below [`EMPTY`] in every run.
+    #[test]
+    fn runs_merged_are_one_run() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / 16_777_216.0
+        };
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for k in 0..600u32 {
+            let centre = Vec3::new(next() * 2.4 - 1.2, next() * 2.4 - 1.2, 0.0);
+            // Depths on a few levels only, so that many triangles tie.
+            let z = (next() * 4.0).floor() * 0.25 - 0.25 + if k % 50 == 0 { -1.5 } else { 0.0 };
+            let size = 0.05 + next() * 0.6;
+            let base = positions.len() as u32;
+            for _ in 0..3 {
+                let offset = Vec3::new(next() - 0.5, next() - 0.5, 0.0) * size;
+                positions.push(centre + offset + Vec3::Z * z);
+            }
+            triangles.push([base, base + 1, base + 2]);
+            if k % 7 == 0 {
+                triangles.push([base, base + 1, base + 2]); // an exact copy: a tie
+            }
+            if k % 97 == 0 {
+                triangles.push([base, base + 1, 1 << 30]); // a bad index
+            }
+        }
+        let proj = Mat4::perspective_rh(1.0, 1.0, 0.1, 10.0)
+            * Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0));
+        for first_id in [0, 7, u32::MAX - 400] {
+            let mut one = VisibilityBuffer::new(24, 20, 2).unwrap();
+            one.draw_in_runs(proj, &positions, &triangles, first_id, 1);
+            assert!(one.triangles().iter().filter(|&&t| t != EMPTY).count() > 500);
+            for runs in [2, 3, 5, 16] {
+                let mut merged = VisibilityBuffer::new(24, 20, 2).unwrap();
+                merged.draw_in_runs(proj, &positions, &triangles, first_id, runs);
+                assert_eq!(merged.triangles(), one.triangles(), "{runs} runs");
+                let bits = |b: &VisibilityBuffer| -> Vec<u32> {
+                    b.depths().iter().map(|d| d.to_bits()).collect()
+                };
+                assert_eq!(bits(&merged), bits(&one), "{runs} runs");
             }
         }
     }
