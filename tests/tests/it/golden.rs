@@ -24,6 +24,7 @@
 //! repeated runs, for the image and for the baked sample file.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use lucent_core::glam::Vec3;
 use lucent_raster::output::image::LAYER_EXITANCE;
@@ -145,9 +146,14 @@ fn compare_rgb(what: &str, got: &[Vec3], want: &[Vec3], exact: bool) {
 /// `want`: byte for byte on the pinned build, within one code per channel elsewhere. Regenerate
 /// with `LUCENT_BLESS=1 cargo test -p lucent-tests --test it golden::`.
 fn assert_png_matches(what: &str, image: &RgbImage, exposure: f32, want: &Path) {
+    // A name of its own for each call: the goldens and the README's pictures share scene
+    // names and file names, and their tests run at once in this process (one file for both
+    // let the README's check read the other's 64-pixel image).
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
     let actual = std::env::temp_dir().join(format!(
-        "lucent-{what}-{}-{}",
+        "lucent-{what}-{}-{}-{}",
         std::process::id(),
+        CALLS.fetch_add(1, Ordering::Relaxed),
         want.file_name().unwrap().to_string_lossy()
     ));
     write_png(&actual, image, exposure).unwrap();
