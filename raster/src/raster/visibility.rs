@@ -414,6 +414,7 @@ fn depth_test_span(depths: &mut [f32], ids: &mut [u32], z0: f32, dz: f32, id: u3
 
 #[cfg(test)]
 mod tests {
+    use super::super::testutil::Rng;
     use super::*;
 
     /// A clip-space vertex at sub-sample position `(sx, sy)` of a `cols × rows` grid, `w = 1`.
@@ -580,13 +581,8 @@ mod tests {
     /// them, and ids stop below [`EMPTY`] in every run.
     #[test]
     fn runs_merged_are_one_run() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / 16_777_216.0
-        };
+        let mut rng = Rng::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.f32_in(0.0, 1.0);
         let mut positions = Vec::new();
         let mut triangles = Vec::new();
         for k in 0..600u32 {
