@@ -54,6 +54,18 @@ pub const READ_IMAGE: Buffer = Buffer {
     remedy: "read it on a machine with more memory",
 };
 
+/// A file read whole (a mesh, a texture, baked samples).
+pub const FILE: Buffer = Buffer {
+    what: "the file's contents",
+    remedy: "use a smaller file",
+};
+
+/// What reading an OBJ file's statements makes (see [`crate::scene::obj`]).
+pub const OBJ_STATEMENTS: Buffer = Buffer {
+    what: "the OBJ file's vertices and faces",
+    remedy: "use a coarser mesh, or a binary format (PLY, glTF)",
+};
+
 /// Peak bytes per triangle from the flattened scene to the placed samples: the shadow BVHs,
 /// the sampler's tiles and the samples' cells. Measured (peak resident set of a sphere of
 /// 1024 segments, 1 M triangles, and of a 7.8 M-triangle OBJ sphere): 239 and 211–218

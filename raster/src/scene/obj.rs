@@ -20,10 +20,11 @@ use super::mesh::{
 };
 use super::model::Mesh;
 use super::obj_reader::{ObjGroup, read_statements};
-use super::origin::MAX_FILE_BYTES;
+use super::origin::MAX_OBJ_BYTES;
 use super::sanity::{
     PositionIds, drop_coincident_triangles, normals_against_winding, orient_outward,
 };
+use crate::memory;
 
 /// Why an OBJ file could not be used.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,22 +81,41 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
 /// The material libraries are not read here: that is left to the scene, which knows whether it
 /// needs them (`kd = "mtl"`).
 ///
-/// Text longer than [`MAX_FILE_BYTES`], the limit of any file a scene reads, is rejected.
+/// Text longer than [`MAX_OBJ_BYTES`] is rejected, and so is text whose reading would need more
+/// memory than the allocator grants (about [`PARSE_BYTES_PER_TEXT_BYTE`] times the text, asked
+/// for at once before reading).
 ///
 /// Bytes that are not UTF-8 are accepted in comments and in `o`, `g` and `s` statements
 /// (replaced by U+FFFD; lucent does not use those names) and rejected with their line anywhere
 /// else, where they would change a number, an index or a name that must match.
 pub fn load_obj(bytes: &[u8]) -> Result<ObjMesh, ObjError> {
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(ObjError {
-            line: None,
-            message: format!(
-                "OBJ text is {} bytes, larger than the {MAX_FILE_BYTES}-byte limit",
-                bytes.len()
-            ),
-            source: None,
-        });
+    load_obj_up_to(bytes, MAX_OBJ_BYTES)
+}
+
+/// Bytes asked for per byte of OBJ text before its statements are read: what the load holds
+/// besides the text (the chunks' statements and their concatenation, which live together for
+/// a moment, then the groups' vertices and the repairs). Measured on a 31 M-triangle sphere
+/// (1.37 GB of text, 42 bytes a triangle; `BENCHMARKS.md`, "Large meshes"): 1.56.
+pub const PARSE_BYTES_PER_TEXT_BYTE: u64 = 2;
+
+/// [`load_obj`] with a size limit of its own.
+fn load_obj_up_to(bytes: &[u8], limit: u64) -> Result<ObjMesh, ObjError> {
+    let refused = |message: String| ObjError {
+        line: None,
+        message,
+        source: None,
+    };
+    let len = bytes.len() as u64;
+    if len > limit {
+        return Err(refused(format!(
+            "OBJ text is {len} bytes, larger than the {limit}-byte limit"
+        )));
     }
+    memory::probe(
+        len.saturating_mul(PARSE_BYTES_PER_TEXT_BYTE),
+        memory::OBJ_STATEMENTS,
+    )
+    .map_err(|e| refused(e.to_string()))?;
     let text = utf8_lines(bytes, &["o", "g", "s"])?;
     let statements = read_statements(&text)?;
     let mut obj = merge(&statements.groups, &statements.usemtl_names)?;
@@ -330,15 +350,16 @@ f 1/1 2/2 3/3 4/4
     }
 
     #[test]
-    fn text_beyond_the_file_limit_is_refused_unread() {
-        // Zeroed pages are not touched until read: the check comes first.
-        let huge = vec![0u8; MAX_FILE_BYTES as usize + 1];
-        let e = parse_obj(&huge).unwrap_err();
+    fn text_beyond_the_limit_is_refused_unread() {
+        let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        assert!(load_obj_up_to(text, text.len() as u64).is_ok());
+        let e = load_obj_up_to(text, text.len() as u64 - 1).unwrap_err();
         assert_eq!(e.line, None);
-        assert!(
-            e.message.contains("larger than the 1073741824-byte limit"),
-            "{e}"
+        assert_eq!(
+            e.message,
+            "OBJ text is 32 bytes, larger than the 31-byte limit"
         );
+        assert_eq!(MAX_OBJ_BYTES, 1 << 36);
     }
 
     #[test]

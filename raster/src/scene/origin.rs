@@ -10,8 +10,16 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-/// Largest file the loader reads (scene, mesh or texture): 1 GiB.
+use crate::memory;
+
+/// Largest file the loader reads (scene, material library, texture, PLY or glTF mesh): 1 GiB.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Largest OBJ file the loader reads: 64 GiB. OBJ text takes about 40 bytes a triangle, so a
+/// scanned mesh of 25 M triangles is already 1 GiB; a render needs about 250 bytes a triangle
+/// besides, so memory, checked before the text is read and again before it is parsed, is what
+/// bounds the size in practice.
+pub const MAX_OBJ_BYTES: u64 = 1 << 36;
 
 /// Where a scene's text came from, which decides how the paths inside it are resolved.
 #[derive(Clone, Debug)]
@@ -69,12 +77,16 @@ impl SceneOrigin {
         }
     }
 
-    /// Reads a file referenced by the scene. The error is a human-readable reason.
+    /// Reads a file referenced by the scene, of at most [`MAX_FILE_BYTES`]. The error is a
+    /// human-readable reason.
     pub fn read(&self, relative: &str) -> Result<Cow<'_, [u8]>, std::io::Error> {
+        self.read_up_to(relative, MAX_FILE_BYTES)
+    }
+
+    /// [`SceneOrigin::read`] with a limit of its own (an OBJ mesh: [`MAX_OBJ_BYTES`]).
+    pub fn read_up_to(&self, relative: &str, limit: u64) -> Result<Cow<'_, [u8]>, std::io::Error> {
         match self {
-            SceneOrigin::File(_) => {
-                read_limited(&self.resolve(relative), MAX_FILE_BYTES).map(Cow::Owned)
-            }
+            SceneOrigin::File(_) => read_limited(&self.resolve(relative), limit).map(Cow::Owned),
             SceneOrigin::Embedded { files, .. } => {
                 let wanted = normalise(relative);
                 files
@@ -105,7 +117,8 @@ pub fn files_read() -> Vec<PathBuf> {
 
 /// Reads a whole file, refusing files larger than `limit` bytes and anything that is not a
 /// regular file: a device such as `/dev/zero` would be read to the limit, a pipe would block.
-/// Records the file in [`files_read`].
+/// The buffer is allocated fallibly: a file larger than memory is an error of kind
+/// `OutOfMemory` naming its size. Records the file in [`files_read`].
 pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, std::io::Error> {
     let too_large =
         |message: String| std::io::Error::new(std::io::ErrorKind::FileTooLarge, message);
@@ -127,7 +140,16 @@ pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, std::io::
             "file is {len} bytes, larger than the {limit}-byte limit"
         )));
     }
-    let mut bytes = Vec::with_capacity(len as usize);
+    let out_of_memory = |e: memory::OutOfMemory| {
+        std::io::Error::new(std::io::ErrorKind::OutOfMemory, e.to_string())
+    };
+    let capacity = usize::try_from(len).map_err(|_| {
+        out_of_memory(memory::OutOfMemory {
+            bytes: len,
+            buffer: memory::FILE,
+        })
+    })?;
+    let mut bytes = memory::with_capacity(capacity, memory::FILE).map_err(out_of_memory)?;
     file.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
         return Err(too_large(format!(

@@ -13,17 +13,17 @@
 use glam::{Vec2, Vec3};
 
 use super::{Corner, MISSING};
-use crate::scene::MAX_FILE_BYTES;
 
 /// Marks a corner slot counted from the chunk's start (see the module's table).
 pub(super) const RELATIVE: u32 = 1 << 31;
 /// Added to a relative slot's offset, which may be negative, to store it unsigned.
 pub(super) const BIAS: i64 = 1 << 29;
-/// More `v`, `vt` or `vn` statements than a file of at most [`MAX_FILE_BYTES`] can hold (each
-/// is at least seven bytes and a line end, like `v 0 0 0`): an index beyond it is out of range
-/// whatever the counts, and an offset within it fits the relative form.
+/// The most `v`, `vt` or `vn` statements a face may reach: an index beyond it is refused
+/// whatever the counts (see `index_error` in `mod.rs` for the message), and an offset within
+/// it fits the relative form. 2²⁸ positions are at least 2 GiB of text (`v 0 0 0` and a line
+/// end each) and would make a mesh of half a billion triangles, beyond what a render's memory
+/// (about 250 bytes a triangle) holds on any machine lucent runs on.
 pub(super) const BEYOND_ANY_COUNT: u64 = 1 << 28;
-const _: () = assert!(BEYOND_ANY_COUNT > MAX_FILE_BYTES / 7);
 const _: () = assert!(BEYOND_ANY_COUNT < BIAS as u64);
 
 /// The first error in a chunk, which ends its reading.
@@ -101,6 +101,11 @@ impl<'a> Chunk<'a> {
     ) -> Result<(), ChunkError> {
         use tobj::LoadError::*;
         let malformed = ChunkError::Malformed;
+        if line.starts_with('#') {
+            // A first word starting with `#` is no statement: skipped without splitting the
+            // line into words, which a long comment would make as slow as its length.
+            return Ok(());
+        }
         let mut words = line.split_whitespace();
         let Some(keyword) = words.next() else {
             return Ok(());

@@ -216,13 +216,14 @@ fn split_lines(text: &str, bytes: usize) -> Vec<&str> {
     let mut parts = Vec::with_capacity(text.len() / bytes.max(1) + 1);
     let mut rest = text;
     while !rest.is_empty() {
-        let end = match rest
-            .as_bytes()
-            .iter()
-            .skip(bytes.max(1))
-            .position(|&b| b == b'\n')
-        {
-            Some(k) => bytes.max(1) + k + 1,
+        // The first line end at or after `bytes` (`str::find` searches with `memchr`: a line
+        // may be as long as the file).
+        let mut from = bytes.max(1).min(rest.len());
+        while !rest.is_char_boundary(from) {
+            from += 1;
+        }
+        let end = match rest[from..].find('\n') {
+            Some(k) => from + k + 1,
             None => rest.len(),
         };
         let (part, after) = rest.split_at(end);
@@ -252,15 +253,35 @@ fn first_error(text: &str, malformed: Option<ObjError>) -> ObjError {
     }
 }
 
-/// The error for a bad face index, found again with its line by the two-pass check.
+/// The error for a bad face index, found again with its line by the two-pass check. Where
+/// that check finds none, the index was within the file's counts but beyond what the reader
+/// holds ([`chunk::BEYOND_ANY_COUNT`]): the file has more vertices than that.
 fn index_error(text: &str) -> ObjError {
-    super::obj::check_indices(text)
-        .err()
-        .unwrap_or_else(|| ObjError {
+    index_error_beyond(text, chunk::BEYOND_ANY_COUNT)
+}
+
+/// [`index_error`] for a reader that holds at most `beyond` of each kind.
+fn index_error_beyond(text: &str, beyond: u64) -> ObjError {
+    super::obj::check_indices(text).err().unwrap_or_else(|| {
+        let most = ["v", "vt", "vn"].map(|statement| {
+            text.lines()
+                .filter(|line| line.split_whitespace().next() == Some(statement))
+                .count() as u64
+        });
+        let message = if most.iter().any(|&n| n > beyond) {
+            format!(
+                "more than {beyond} vertices, texture coordinates or normals: beyond what the \
+                 reader holds"
+            )
+        } else {
+            "a face corner names no vertex".to_string()
+        };
+        ObjError {
             line: None,
-            message: "a face corner names no vertex".to_string(),
+            message,
             source: None,
-        })
+        }
+    })
 }
 
 #[cfg(test)]

@@ -338,3 +338,29 @@ fn malformed_statements_name_their_line_and_kind() {
     assert_eq!(e.line, Some(2));
     assert!(e.message.contains("index 2 out of range"), "{e}");
 }
+
+/// An index the file defines but the reader cannot hold is reported as the reader's limit,
+/// not as a corner naming no vertex (the reader's bound lowered to 2 to make such a file).
+#[test]
+fn a_file_beyond_the_readers_counts_names_the_limit() {
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let beyond = index_error_beyond(text, 2);
+    assert_eq!(beyond.line, None);
+    assert_eq!(
+        beyond.message,
+        "more than 2 vertices, texture coordinates or normals: beyond what the reader holds"
+    );
+    assert_eq!(
+        index_error_beyond(text, 3).message,
+        "a face corner names no vertex"
+    );
+    // A real index error keeps its line, whatever the bound.
+    let bad = index_error_beyond("v 0 0 0\nf 1 2 3\n", 0);
+    assert_eq!(bad.line, Some(2));
+    // Comments are skipped whole, however long: a first word starting with `#` is never a
+    // statement, so a comment that looks like one changes nothing.
+    let commented = read_statements("v 0 0 0\n#v 1 1 1\n# f 1 1 1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+        .expect("valid");
+    assert_eq!(commented.groups[0].positions.len(), 3);
+    assert_eq!(commented.groups[0].triangles, vec![[0, 1, 2]]);
+}

@@ -15,6 +15,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// What the pre-filled outputs hold before every run.
 pub const PREVIOUS: &[u8] = b"previous contents: must survive a failed run\n";
 
+/// Files larger than this are compared by length and time of modification in a
+/// [`Sandbox::snapshot`] (a mesh of more than 1 GiB, say).
+const LARGE_FILE: u64 = 64 << 20;
+
 /// The exit code of a Rust panic: never acceptable.
 const PANIC_EXIT: i32 = 101;
 
@@ -179,7 +183,8 @@ impl Sandbox {
         self.write("out.exr", PREVIOUS);
     }
 
-    /// Every entry of the directory (recursively) with its contents (`None` for directories).
+    /// Every entry of the directory (recursively) with its contents (`None` for directories;
+    /// for a file of more than [`LARGE_FILE`] bytes, its length and time of modification).
     pub fn snapshot(&self) -> BTreeMap<String, Option<Vec<u8>>> {
         fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Option<Vec<u8>>>) {
             for entry in std::fs::read_dir(dir).expect("list the sandbox") {
@@ -193,10 +198,16 @@ impl Sandbox {
                     out.insert(name, None);
                     walk(root, &path, out);
                 } else {
-                    out.insert(
-                        name,
-                        Some(std::fs::read(&path).expect("read a sandbox file")),
-                    );
+                    let len = path.metadata().expect("a sandbox file's metadata").len();
+                    let contents = if len > LARGE_FILE {
+                        // Its length and time of modification: reading it twice per run cost
+                        // seconds, and a run that rewrote it would change the time.
+                        let modified = path.metadata().and_then(|m| m.modified());
+                        format!("{len} bytes, modified {modified:?}").into_bytes()
+                    } else {
+                        std::fs::read(&path).expect("read a sandbox file")
+                    };
+                    out.insert(name, Some(contents));
                 }
             }
         }

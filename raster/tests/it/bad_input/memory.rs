@@ -176,3 +176,35 @@ fn an_exr_larger_than_memory_is_refused_before_it_is_decoded() {
         &["big.exr: out of memory: could not allocate 1.8 GiB for the image's pixels"],
     );
 }
+
+/// An OBJ larger than memory is refused with the size of what it needs: under 0.75 GiB of
+/// address space, its 1 GiB of text; under 1.2 GiB, which holds 512 MiB of text, what reading
+/// its statements may need (twice the text, asked for before the reading starts).
+#[test]
+#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
+fn an_obj_larger_than_memory_is_refused_before_it_is_read() {
+    let text = scene("obj = \"mesh.obj\"", CONSTANT);
+    let small = Sandbox::with_scene("memory-obj-text", &text).with_address_space(LIMIT_KIB / 2);
+    super::obj::write_padded_octahedron(&small, (1u64 << 30) + (1 << 20));
+    small.fails(
+        &["scene.toml"],
+        1,
+        &[
+            "object[0].obj",
+            "cannot read mesh mesh.obj: out of memory: could not allocate 1.0 GiB for the \
+             file's contents (use a smaller file, or free memory)",
+        ],
+    );
+    let larger =
+        Sandbox::with_scene("memory-obj-statements", &text).with_address_space(LIMIT_KIB * 4 / 5);
+    super::obj::write_padded_octahedron(&larger, 1 << 29);
+    larger.fails(
+        &["scene.toml"],
+        1,
+        &[
+            "object[0].obj",
+            "mesh.obj: out of memory: could not allocate 1.0 GiB for the OBJ file's vertices \
+             and faces (use a coarser mesh, or a binary format (PLY, glTF), or free memory)",
+        ],
+    );
+}

@@ -45,6 +45,34 @@ fn valid_obj_renders() {
     sb.succeeds(&render(&[]));
 }
 
+/// Writes the octahedron as `mesh.obj`, its last line a comment of NUL bytes that makes the file
+/// `len` bytes long. The file is sparse: no disk space and no time to write it.
+pub(super) fn write_padded_octahedron(sb: &Sandbox, len: u64) {
+    let path = sb.path("mesh.obj");
+    let mut text = OCTAHEDRON.to_string();
+    text.push('#');
+    std::fs::write(&path, text).unwrap();
+    std::fs::File::options()
+        .write(true)
+        .open(&path)
+        .and_then(|f| f.set_len(len))
+        .unwrap();
+}
+
+/// An OBJ of more than 1 GiB (the limit of other files a scene reads) is read: a scanned mesh
+/// of 25 M triangles already takes that much text.
+#[test]
+#[cfg(target_pointer_width = "64")]
+fn obj_text_beyond_one_gib_is_read() {
+    let sb = mesh_sandbox("obj-beyond-1gib");
+    let len = (1u64 << 30) + (1 << 20);
+    write_padded_octahedron(&sb, len);
+    let out = sb.succeeds(&render(&["--samples", "50"]));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("limit"), "{stderr}");
+    assert_eq!(std::fs::metadata(sb.path("mesh.obj")).unwrap().len(), len);
+}
+
 /// The octahedron with 500 coincident copies of its faces, half of them wound the other way:
 /// the copies are dropped with one warning, and the render is the octahedron's (before, the
 /// sampler placed and thinned samples on 500 layers of the same surface).
