@@ -147,7 +147,16 @@ fn random_file(rng: &mut Rng) -> String {
                 out.push_str(&format!("{indent}usemtl {name}\n"));
             }
             5 => out.push_str(
-                ["mtllib x.mtl\n", "# f 1 2 3\n", "\n", "s off\n"][rng.range_i64(0, 4) as usize],
+                [
+                    "mtllib x.mtl\n",
+                    "# f 1 2 3\n",
+                    "\n",
+                    "s off\n",
+                    "#f 1 2 3\n",
+                    "  #v 1 2 3\n",
+                    "\t#usemtl a\n",
+                    "#\n",
+                ][rng.range_i64(0, 8) as usize],
             ),
             _ => {
                 let keyword = if rng.range_i64(0, 8) == 0 { "l" } else { "f" };
