@@ -15,7 +15,8 @@ use crate::output::{
     Placement, Region, output_target, refuse_read_only, write_exr, write_exr_tile, write_png,
 };
 use crate::render::{
-    self, LIGHTING_COMMENT, METHOD_COMMENT, RenderOptions, read_baked_with_provenance, write_baked,
+    self, LIGHTING_COMMENT, METHOD_COMMENT, RenderOptions, read_baked_with_provenance, spinner,
+    write_baked,
 };
 use crate::scene::{
     MAX_INTERPOLATION_STEP, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_THREADS, OutputSettings,
@@ -23,24 +24,28 @@ use crate::scene::{
 };
 
 /// Loads the scene named on the command line, or the built-in default, printing its
-/// warnings on stderr. Mesh files are read with `--threads` threads when given (checked here,
-/// before any reading), else with every core.
-fn load(path: Option<&Path>, threads: Option<usize>) -> Result<Scene, String> {
+/// warnings on stderr (and, with `progress`, the time taken while it lasts). Mesh files are
+/// read with `--threads` threads when given (checked here, before any reading), else with
+/// every core.
+fn load(path: Option<&Path>, threads: Option<usize>, progress: bool) -> Result<Scene, String> {
     let read = || match path {
         Some(p) => load_scene(p).map_err(|e| e.to_string()),
         None => Ok(default_scene()),
     };
+    if let Some(n) = threads {
+        check_threads(n)?;
+    }
+    let phase = spinner(progress, "load");
     let scene = match threads {
-        Some(n) => {
-            check_threads(n)?;
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| format!("cannot start {n} threads: {e}"))?
-                .install(read)?
-        }
-        None => read()?,
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| format!("cannot start {n} threads: {e}"))
+            .and_then(|pool| pool.install(read)),
+        None => read(),
     };
+    phase.finish_and_clear();
+    let scene = scene?;
     for warning in &scene.warnings {
         errln!("warning: {warning}");
     }
@@ -343,7 +348,7 @@ fn output_bytes(pixels: usize, output: &OutputSettings) -> u64 {
 /// `lucent render`.
 pub fn render(args: &RenderArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
-    let mut scene = load(args.scene.as_deref(), args.threads)?;
+    let mut scene = load(args.scene.as_deref(), args.threads, !args.quiet)?;
     apply(args, &mut scene)?;
     if let Some(crop) = &args.crop {
         check_crop(crop, args, &scene)?;
@@ -454,7 +459,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
 
 /// `lucent bake`.
 pub fn bake(args: &BakeArgs) -> Result<(), String> {
-    let mut scene = load(args.scene.as_deref(), args.threads)?;
+    let mut scene = load(args.scene.as_deref(), args.threads, !args.quiet)?;
     density(args.samples, args.spacing, args.max_samples, &mut scene)?;
     threads(args.threads, &mut scene)?;
     seed(args.seed, &mut scene)?;

@@ -62,6 +62,7 @@ use crate::raster::VisibilityBuffer;
 use crate::scene::Scene;
 use interpolation::{BAND_GRID_ROWS, ExitanceGrid, Interpolation};
 use progress::bar;
+pub(crate) use progress::spinner;
 
 /// Options beyond the scene's own settings.
 #[derive(Clone, Copy, Debug, Default)]
@@ -222,7 +223,10 @@ pub fn bake_planned(
 ) -> Result<(Vec<ObjectSamples>, Option<DensityPlan>), RenderError> {
     let pool = thread_pool(scene.render.threads)?;
     pool.install(|| {
-        let prep = Prepared::new(scene)?;
+        let b = spinner(progress, "prepare");
+        let prep = Prepared::new(scene);
+        b.finish_and_clear();
+        let prep = prep?;
         let plan = density::plan(&prep, &scene.render, None)?;
         warn_once(warn, plan.as_ref(), scene);
         let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
@@ -278,7 +282,10 @@ fn render_in_pool(
         .map_err(RenderError::Crop)?;
 
     let t = Instant::now();
-    let prep = Prepared::new(scene)?;
+    let b = spinner(options.progress, "prepare");
+    let prep = Prepared::new(scene);
+    b.finish_and_clear();
+    let prep = prep?;
     let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
     timings.prepare = t.elapsed();
 

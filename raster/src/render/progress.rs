@@ -1,11 +1,14 @@
-//! Progress of the long phases (sampling, irradiance, shading) on stderr.
+//! Progress of the long phases on stderr: a bar for those that count their steps (sampling,
+//! irradiance, shading), the time alone for those that do not (loading the scene,
+//! preparing it: with a scanned mesh of millions of triangles, either can take a minute).
 //!
-//! On a terminal, a bar redrawn in place. Anywhere else (a redirected stderr, a farm's job
+//! On a terminal, a bar (or a spinner) redrawn in place. Anywhere else (a redirected stderr, a farm's job
 //! log) a bar's redraws would be noise, and silence until the end leaves whoever watches the
 //! log unable to tell a long render from a hung one. So there a phase that runs longer than
 //! [`LOG_INTERVAL`] writes one plain line per interval:
 //!
 //! ```text
+//! lucent: load after 0:00:10
 //! lucent: shading 45% after 0:01:23, about 0:01:41 left
 //! ```
 //!
@@ -47,6 +50,33 @@ pub(crate) fn bar(enabled: bool, len: u64, message: &'static str) -> ProgressBar
             .progress_chars("=> "),
     );
     bar.set_message(message);
+    bar
+}
+
+/// A phase without a count of its steps, `message`: a spinner with the time elapsed on a
+/// terminal, a line every [`LOG_INTERVAL`] elsewhere (`lucent: load after 0:00:10`), nothing
+/// when `enabled` is false. Finish it with `finish_and_clear`, also when the phase fails.
+pub(crate) fn spinner(enabled: bool, message: &'static str) -> ProgressBar {
+    if !enabled {
+        return ProgressBar::hidden();
+    }
+    if !std::io::stderr().is_terminal() {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+        log_while_running(
+            &bar,
+            message,
+            LOG_INTERVAL,
+            Arc::new(Mutex::new(std::io::stderr())),
+        );
+        return bar;
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} {spinner} {elapsed_precise}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    bar.set_message(message);
+    bar.enable_steady_tick(Duration::from_millis(200));
     bar
 }
 
@@ -174,5 +204,26 @@ mod tests {
                 "{line}"
             );
         }
+    }
+
+    /// A phase without a count (a [`spinner`] off a terminal) logs the time alone.
+    #[test]
+    fn a_phase_without_a_count_logs_its_time() {
+        let sink = Arc::new(Mutex::new(Vec::<u8>::new()));
+        let phase = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+        log_while_running(&phase, "load", Duration::from_millis(20), sink.clone());
+        let start = Instant::now();
+        let logged = loop {
+            let text = String::from_utf8(sink.lock().expect("sink").clone()).expect("utf-8");
+            if text.contains('\n') {
+                break text;
+            }
+            assert!(start.elapsed() < Duration::from_secs(30), "no line logged");
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        phase.finish_and_clear();
+        let first = logged.lines().next().expect("a line");
+        assert!(first.starts_with("lucent: load after 0:00:"), "{first}");
+        assert!(!first.contains('%'), "{first}");
     }
 }
