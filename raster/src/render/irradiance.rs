@@ -13,6 +13,7 @@
 //! diffuse from one object into another.
 
 use std::borrow::Cow;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{Vec2, Vec3};
 use lucent_core::{CellAverage, IrradianceCache, LocalQuadrature, Method, Sample};
@@ -23,7 +24,7 @@ use super::prepare::Prepared;
 use crate::lights::{Lighting, ShadowHints};
 use crate::memory;
 use crate::sampling::rng::splitmix64;
-use crate::sampling::{SampleTarget, poisson_samples_with_progress, voronoi_areas};
+use crate::sampling::{SampleTarget, poisson_samples_with_progress, voronoi_areas_with_progress};
 use crate::scene::SampleDensity;
 
 /// The samples on one translucent object.
@@ -102,9 +103,19 @@ pub fn place_samples(
         SampleDensity::Count(n) => SampleTarget::Count(n),
         SampleDensity::Spacing(s) => SampleTarget::Spacing(s),
     };
-    let show = |done: f32| progress.set_position((done * 1000.0) as u64);
-    let points = poisson_samples_with_progress(&triangles, target, seed, &show)
-        .map_err(RenderError::Sampling)?;
+    // The bar's 1000 steps: the first half placing the samples, the second their areas (on a
+    // scanned mesh of millions of triangles, the areas take the longer).
+    let shown = AtomicU64::new(0);
+    let show = |position: u64| {
+        // The areas report from several threads: the bar only moves forward.
+        if shown.fetch_max(position, Ordering::Relaxed) < position {
+            progress.set_position(position);
+        }
+    };
+    let points = poisson_samples_with_progress(&triangles, target, seed, &|done| {
+        show((done.clamp(0.0, 1.0) * 500.0) as u64)
+    })
+    .map_err(RenderError::Sampling)?;
 
     let mut sets: Vec<ObjectSamples> = objects
         .iter()
@@ -127,13 +138,22 @@ pub fn place_samples(
     }
     drop(points);
     drop(triangles);
+    let mut areas_before = 0;
     for (set, placed) in sets.iter_mut().zip(placed) {
         if set.is_empty() {
             continue;
         }
         let first = prep.first_triangle[set.object] as usize;
         let last = prep.first_triangle[set.object + 1] as usize;
-        let cells = voronoi_areas(&prep.triangles[first..last], &set.positions);
+        // Each object's share of the second half: its share of the triangles.
+        let share = |done: f32| {
+            let triangles =
+                areas_before as f64 + done.clamp(0.0, 1.0) as f64 * (last - first) as f64;
+            show(500 + (500.0 * triangles / count.max(1) as f64) as u64);
+        };
+        let cells =
+            voronoi_areas_with_progress(&prep.triangles[first..last], &set.positions, &share);
+        areas_before += last - first;
         set.areas = cells.areas;
         let mesh = &prep.scene.objects[set.object].mesh;
         set.normals.reserve_exact(placed.len());

@@ -43,7 +43,7 @@ pub use error::{MAX_SAMPLES, SamplingError};
 pub use poisson::{poisson_samples, poisson_samples_with_progress};
 pub use stratified::{StratifiedSquare, stratified_square};
 pub use surface::{SampleTarget, SurfacePoint, hex_spacing, total_area, triangle_area};
-pub use voronoi::{VoronoiAreas, VoronoiStats, voronoi_areas};
+pub use voronoi::{VoronoiAreas, VoronoiStats, voronoi_areas, voronoi_areas_with_progress};
 
 #[cfg(test)]
 mod tests;

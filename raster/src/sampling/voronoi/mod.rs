@@ -147,12 +147,30 @@ pub struct VoronoiStats {
 /// total area. The sites should lie on the triangles (those of one object); the result is a
 /// pure function of the input.
 pub fn voronoi_areas(triangles: &[[Vec3; 3]], sites: &[Vec3]) -> VoronoiAreas {
-    areas_of_cells(triangles, sites, true)
+    areas_of_cells(triangles, sites, true, &|_| {})
 }
 
-/// [`voronoi_areas`], taking the triangles that lie wholly in one cell without clipping them
-/// when `whole_triangles` (the same bits either way).
-fn areas_of_cells(triangles: &[[Vec3; 3]], sites: &[Vec3], whole_triangles: bool) -> VoronoiAreas {
+/// [`voronoi_areas`], calling `progress` with the share of the work done, from 0 to 1, from
+/// any of the threads (so not always in increasing order). The shares are those of the steps'
+/// times on meshes of 2 M and 7.8 M triangles with 23 000 sites: registering the triangles
+/// with the sites' grid 0.3, finding the triangles wholly in one cell 0.25, clipping the cells
+/// 0.35 (in steps of one task), their centroids 0.1.
+pub fn voronoi_areas_with_progress(
+    triangles: &[[Vec3; 3]],
+    sites: &[Vec3],
+    progress: &(dyn Fn(f32) + Sync),
+) -> VoronoiAreas {
+    areas_of_cells(triangles, sites, true, progress)
+}
+
+/// [`voronoi_areas_with_progress`], taking the triangles that lie wholly in one cell without
+/// clipping them when `whole_triangles` (the same bits either way).
+fn areas_of_cells(
+    triangles: &[[Vec3; 3]],
+    sites: &[Vec3],
+    whole_triangles: bool,
+    progress: &(dyn Fn(f32) + Sync),
+) -> VoronoiAreas {
     let mut out = VoronoiAreas {
         areas: vec![0.0; sites.len()],
         centroids: sites
@@ -177,6 +195,7 @@ fn areas_of_cells(triangles: &[[Vec3; 3]], sites: &[Vec3], whole_triangles: bool
         |(n, l, h), &p| (n + 1, l.min(p), h.max(p)),
     );
     if count == 0 {
+        progress(1.0);
         return out;
     }
     if total <= 0.0 {
@@ -186,6 +205,7 @@ fn areas_of_cells(triangles: &[[Vec3; 3]], sites: &[Vec3], whole_triangles: bool
             }
         }
         out.stats.empty = count as u64;
+        progress(1.0);
         return out;
     }
     let spacing = hex_spacing(total, count.min(u32::MAX as usize) as u32) as f64;
@@ -197,11 +217,13 @@ fn areas_of_cells(triangles: &[[Vec3; 3]], sites: &[Vec3], whole_triangles: bool
     // Registration reaches a little further than the pass, so that float rounding in the
     // boxes cannot drop a triangle a site reaches.
     cells.register_triangles(triangles, &live, reach * 1.01);
+    progress(0.3);
     let owners = if whole_triangles {
         triangle_owners(&cells, triangles, &live, reach)
     } else {
         vec![SHARED; triangles.len()]
     };
+    progress(0.55);
     let pass = Pass {
         triangles,
         owners: &owners,
@@ -209,9 +231,10 @@ fn areas_of_cells(triangles: &[[Vec3; 3]], sites: &[Vec3], whole_triangles: bool
         reach2: reach * reach,
         sorted: SORTED / CELL * size,
     };
-    let (cell_sums, stats) = pass.run();
+    let (cell_sums, stats) = pass.run(&|done| progress(0.55 + 0.35 * done));
     out.stats = stats;
     let centroids = pass.centroids_on_surface(&cell_sums);
+    progress(1.0);
     for ((&i, &(a, _)), c) in cells.order.iter().zip(&cell_sums).zip(centroids) {
         out.stats.empty += (a <= 0.0) as u64;
         out.areas[i as usize] = a.max(f32::MIN_POSITIVE);
@@ -256,8 +279,9 @@ struct Scratch {
 }
 
 impl Pass<'_> {
-    /// Area and centroid per sorted site, and the counters.
-    fn run(&self) -> (Vec<CellSum>, VoronoiStats) {
+    /// Area and centroid per sorted site, and the counters; `progress` gets the share of the
+    /// tasks done after each.
+    fn run(&self, progress: &(dyn Fn(f32) + Sync)) -> (Vec<CellSum>, VoronoiStats) {
         let cells = self.cells;
         let n = cells.sites.len();
         let flags: Vec<AtomicU8> = (0..self.triangles.len())
@@ -275,6 +299,8 @@ impl Pass<'_> {
             tasks.push((first..last, head));
             rest = tail;
         }
+        let task_count = tasks.len().max(1) as f32;
+        let tasks_done = AtomicU64::new(0);
         tasks
             .into_par_iter()
             .for_each_init(Scratch::default, |scratch, (range, out)| {
@@ -301,6 +327,8 @@ impl Pass<'_> {
                 widened.fetch_add(counts[1], Ordering::Relaxed);
                 shared.fetch_add(counts[2], Ordering::Relaxed);
                 whole.fetch_add(counts[3], Ordering::Relaxed);
+                let done = tasks_done.fetch_add(1, Ordering::Relaxed) + 1;
+                progress(done as f32 / task_count);
             });
         let mut stats = VoronoiStats {
             clipped: clipped.into_inner(),

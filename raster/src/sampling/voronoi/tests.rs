@@ -347,8 +347,8 @@ fn whole_triangles_give_the_bits_clipping_gives() {
     doubled.extend_from_within(..20);
     cases.push((fine, doubled));
     for (tris, sites) in cases {
-        let with = areas_of_cells(&tris, &sites, true);
-        let without = areas_of_cells(&tris, &sites, false);
+        let with = areas_of_cells(&tris, &sites, true, &|_| {});
+        let without = areas_of_cells(&tris, &sites, false, &|_| {});
         // The triangles of other sites' cells are not even looked at.
         assert!(
             with.stats.clipped + with.stats.whole < without.stats.clipped,
@@ -374,4 +374,33 @@ fn whole_triangles_give_the_bits_clipping_gives() {
         assert_eq!(bits(&with), bits(&without));
         assert_eq!(with.centroids, without.centroids);
     }
+}
+
+/// The progress reported covers the whole run, from its steps and its tasks, and reporting it
+/// changes nothing.
+#[test]
+fn progress_reaches_one_and_changes_nothing() {
+    let tris = icosphere(5, Vec3::ZERO, 1.0);
+    let sites = poisson(&tris, 3000, 5);
+    let reports = std::sync::Mutex::new(Vec::new());
+    let with = voronoi_areas_with_progress(&tris, &sites, &|done| {
+        reports.lock().expect("reports").push(done)
+    });
+    let without = voronoi_areas(&tris, &sites);
+    assert_eq!(with.areas, without.areas);
+    assert_eq!(with.stats, without.stats);
+    let reports = reports.into_inner().expect("reports");
+    assert!(
+        reports.iter().all(|d| (0.0..=1.0).contains(d)),
+        "{reports:?}"
+    );
+    assert_eq!(reports.last(), Some(&1.0));
+    // The steps, and the tasks of the clipping between them.
+    for step in [0.3, 0.55, 0.9] {
+        assert!(
+            reports.iter().any(|&d| (d - step).abs() < 1e-6),
+            "{step}: {reports:?}"
+        );
+    }
+    assert!(reports.iter().any(|&d| d > 0.55 && d < 0.9), "{reports:?}");
 }
