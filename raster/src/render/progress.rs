@@ -34,14 +34,7 @@ pub(crate) fn bar(enabled: bool, len: u64, message: &'static str) -> ProgressBar
         return ProgressBar::hidden();
     }
     if !std::io::stderr().is_terminal() {
-        let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::hidden());
-        log_while_running(
-            &bar,
-            message,
-            LOG_INTERVAL,
-            Arc::new(Mutex::new(std::io::stderr())),
-        );
-        return bar;
+        return logged(Some(len), message);
     }
     let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
     bar.set_style(
@@ -61,14 +54,7 @@ pub(crate) fn spinner(enabled: bool, message: &'static str) -> ProgressBar {
         return ProgressBar::hidden();
     }
     if !std::io::stderr().is_terminal() {
-        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
-        log_while_running(
-            &bar,
-            message,
-            LOG_INTERVAL,
-            Arc::new(Mutex::new(std::io::stderr())),
-        );
-        return bar;
+        return logged(None, message);
     }
     let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
     bar.set_style(
@@ -77,6 +63,19 @@ pub(crate) fn spinner(enabled: bool, message: &'static str) -> ProgressBar {
     );
     bar.set_message(message);
     bar.enable_steady_tick(Duration::from_millis(200));
+    bar
+}
+
+/// A hidden bar of `length` steps (`None`: uncounted) whose phase is logged on stderr every
+/// [`LOG_INTERVAL`].
+fn logged(length: Option<u64>, message: &'static str) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(length, ProgressDrawTarget::hidden());
+    log_while_running(
+        &bar,
+        message,
+        LOG_INTERVAL,
+        Arc::new(Mutex::new(std::io::stderr())),
+    );
     bar
 }
 
