@@ -66,6 +66,12 @@ pub const OBJ_STATEMENTS: Buffer = Buffer {
     remedy: "use a coarser mesh, or a binary format (PLY, glTF)",
 };
 
+/// The vertex and face lists a PLY file declares.
+pub const PLY_LISTS: Buffer = Buffer {
+    what: "the PLY file's vertices and faces",
+    remedy: "use a coarser mesh",
+};
+
 /// Peak bytes per triangle from the flattened scene to the placed samples: the shadow BVHs,
 /// the sampler's tiles and the samples' cells. Measured (peak resident set of a sphere of
 /// 1024 segments, 1 M triangles, and of a 7.8 M-triangle OBJ sphere): 239 and 211–218

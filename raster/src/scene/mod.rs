@@ -48,7 +48,7 @@ pub use load::{MAX_SCENE_BYTES, load_scene, parse_scene};
 pub use materials::preset_names;
 pub use model::*;
 pub use objects::SHAPES;
-pub use origin::{MAX_FILE_BYTES, MAX_OBJ_BYTES, SceneOrigin, files_read};
+pub use origin::{MAX_FILE_BYTES, MAX_MESH_FILE_BYTES, SceneOrigin, files_read};
 pub use settings::{
     AUTO, DEFAULT_RESOLUTION, LAYERS, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_THREADS,
 };

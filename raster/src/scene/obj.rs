@@ -20,7 +20,7 @@ use super::mesh::{
 };
 use super::model::Mesh;
 use super::obj_reader::{ObjGroup, read_statements};
-use super::origin::MAX_OBJ_BYTES;
+use super::origin::MAX_MESH_FILE_BYTES;
 use super::sanity::{
     PositionIds, drop_coincident_triangles, normals_against_winding, orient_outward,
 };
@@ -81,7 +81,7 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
 /// The material libraries are not read here: that is left to the scene, which knows whether it
 /// needs them (`kd = "mtl"`).
 ///
-/// Text longer than [`MAX_OBJ_BYTES`] is rejected, and so is text whose reading would need more
+/// Text longer than [`MAX_MESH_FILE_BYTES`] is rejected, and so is text whose reading would need more
 /// memory than the allocator grants (about [`PARSE_BYTES_PER_TEXT_BYTE`] times the text, asked
 /// for at once before reading).
 ///
@@ -89,7 +89,7 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, ObjError> {
 /// (replaced by U+FFFD; lucent does not use those names) and rejected with their line anywhere
 /// else, where they would change a number, an index or a name that must match.
 pub fn load_obj(bytes: &[u8]) -> Result<ObjMesh, ObjError> {
-    load_obj_up_to(bytes, MAX_OBJ_BYTES)
+    load_obj_up_to(bytes, MAX_MESH_FILE_BYTES)
 }
 
 /// Bytes asked for per byte of OBJ text before its statements are read: what the load holds
@@ -359,7 +359,7 @@ f 1/1 2/2 3/3 4/4
             e.message,
             "OBJ text is 32 bytes, larger than the 31-byte limit"
         );
-        assert_eq!(MAX_OBJ_BYTES, 1 << 36);
+        assert_eq!(MAX_MESH_FILE_BYTES, 1 << 36);
     }
 
     #[test]

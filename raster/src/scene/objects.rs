@@ -17,7 +17,7 @@ use super::mesh_file::{MESH_EXTENSIONS, MeshFileError, MeshFormat, parse_mesh_fi
 use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialRef, MaterialTable, ObjGroups, split_by_material};
-use super::origin::{MAX_FILE_BYTES, MAX_OBJ_BYTES, SceneOrigin};
+use super::origin::{MAX_FILE_BYTES, MAX_MESH_FILE_BYTES, SceneOrigin};
 use super::sanity::{
     PositionIds, drop_coincident_triangles, normals_against_winding, orient_outward,
 };
@@ -288,8 +288,8 @@ fn load_mesh(
         ));
     };
     let path = origin.resolve(name);
-    let limit = if format == MeshFormat::Obj {
-        MAX_OBJ_BYTES
+    let limit = if matches!(format, MeshFormat::Obj | MeshFormat::Ply) {
+        MAX_MESH_FILE_BYTES
     } else {
         MAX_FILE_BYTES
     };

@@ -24,6 +24,7 @@ use glam::{Vec2, Vec3};
 
 use super::mesh::finish_loaded_mesh;
 use super::model::Mesh;
+use crate::memory;
 use crate::output::ply::header::{Element, Format, Header, Kind, Scalar};
 
 /// Texture-coordinate property pairs, in order of preference.
@@ -79,6 +80,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Mesh, PlyError> {
     let start = header.length as usize;
     let body_len = (bytes.len() - start) as u64;
     check_counts(&header, body_len)?;
+    probe_lists(&header, &layout)?;
     let mut body = match header.format {
         Format::Ascii => Body::Ascii {
             bytes,
@@ -107,12 +109,13 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Mesh, PlyError> {
         if element.name == "vertex" {
             // Bounded by `check_counts`.
             let n = element.count as usize;
-            positions.reserve_exact(n);
+            let refused = |_| out_of_memory(&header, &layout);
+            positions.try_reserve_exact(n).map_err(refused)?;
             if layout.normal.is_some() {
-                normals.reserve_exact(n);
+                normals.try_reserve_exact(n).map_err(refused)?;
             }
             if layout.uv.is_some() {
-                uvs.reserve_exact(n);
+                uvs.try_reserve_exact(n).map_err(refused)?;
             }
             read_vertices(
                 &mut body,
@@ -123,7 +126,9 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Mesh, PlyError> {
                 &mut uvs,
             )?;
         } else if element.name == "face" {
-            triangles.reserve(element.count as usize);
+            triangles
+                .try_reserve(element.count as usize)
+                .map_err(|_| out_of_memory(&header, &layout))?;
             read_faces(
                 &mut body,
                 element,
@@ -131,7 +136,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Mesh, PlyError> {
                 positions.len(),
                 &mut triangles,
             )?;
-        } else {
+        } else if !body.skip_fixed(element) {
             for _ in 0..element.count {
                 for p in &element.properties {
                     body.skip(p.kind)?;
@@ -285,6 +290,34 @@ fn check_counts(header: &Header, body_len: u64) -> Result<(), PlyError> {
         return Err(at_line(v.line, format!("too many vertices ({})", v.count)));
     }
     Ok(())
+}
+
+/// Bytes the vertex and face lists will hold: 12 a position, 12 a normal, 8 a texture
+/// coordinate and 12 a triangle (at least one per face).
+fn list_bytes(header: &Header, layout: &MeshLayout) -> u64 {
+    let count = |name| header.element(name).map_or(0, |e| e.count);
+    let per_vertex =
+        12 + 12 * u64::from(layout.normal.is_some()) + 8 * u64::from(layout.uv.is_some());
+    count("vertex")
+        .saturating_mul(per_vertex)
+        .saturating_add(count("face").saturating_mul(12))
+}
+
+/// The error for lists larger than memory.
+fn out_of_memory(header: &Header, layout: &MeshLayout) -> PlyError {
+    let refused = memory::OutOfMemory {
+        bytes: list_bytes(header, layout),
+        buffer: memory::PLY_LISTS,
+    };
+    at_line(0, refused.to_string())
+}
+
+/// Asks for the vertex and face lists' memory at once, before reading them: their counts are
+/// bounded by the body's length (`check_counts`), but an ASCII vertex of three one-character
+/// numbers becomes 12 bytes or more.
+fn probe_lists(header: &Header, layout: &MeshLayout) -> Result<(), PlyError> {
+    memory::probe(list_bytes(header, layout), memory::PLY_LISTS)
+        .map_err(|_| out_of_memory(header, layout))
 }
 
 fn read_vertices(
@@ -469,6 +502,28 @@ impl<'a> Body<'a> {
             )));
         }
         Ok(n)
+    }
+
+    /// Reads past a whole binary element of scalar properties at once, if it fits in what is
+    /// left; false (nothing read) otherwise, where reading entry by entry finds the error.
+    fn skip_fixed(&mut self, element: &Element) -> bool {
+        let Body::Binary { bytes, pos, .. } = self else {
+            return false;
+        };
+        let mut size = 0u64;
+        for p in &element.properties {
+            match p.kind {
+                Kind::Scalar(t) => size += t.size() as u64,
+                Kind::List { .. } => return false,
+            }
+        }
+        match element.count.checked_mul(size) {
+            Some(total) if total <= (bytes.len() - *pos) as u64 => {
+                *pos += total as usize;
+                true
+            }
+            _ => false,
+        }
     }
 
     /// Reads past one property.

@@ -18,6 +18,8 @@ mod memory;
 mod obj;
 mod outputs;
 mod ply;
+#[cfg(unix)]
+mod ply_mesh;
 mod scene;
 mod texture;
 mod tiles;
