@@ -15,7 +15,7 @@ use crate::output::{
     Placement, Region, output_target, refuse_read_only, write_exr, write_exr_tile, write_png,
 };
 use crate::render::{
-    self, LIGHTING_COMMENT, METHOD_COMMENT, RenderOptions, read_baked_with_provenance, spinner,
+    self, LIGHTING_COMMENT, METHOD_COMMENT, RenderOptions, during, read_baked_with_provenance,
     write_baked,
 };
 use crate::scene::{
@@ -35,17 +35,14 @@ fn load(path: Option<&Path>, threads: Option<usize>, progress: bool) -> Result<S
     if let Some(n) = threads {
         check_threads(n)?;
     }
-    let phase = spinner(progress, "load");
-    let scene = match threads {
+    let scene = during(progress, "load", || match threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
             .map_err(|e| format!("cannot start {n} threads: {e}"))
             .and_then(|pool| pool.install(read)),
         None => read(),
-    };
-    phase.finish_and_clear();
-    let scene = scene?;
+    })?;
     for warning in &scene.warnings {
         errln!("warning: {warning}");
     }

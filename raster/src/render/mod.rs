@@ -62,7 +62,7 @@ use crate::raster::VisibilityBuffer;
 use crate::scene::Scene;
 use interpolation::{BAND_GRID_ROWS, ExitanceGrid, Interpolation};
 use progress::bar;
-pub(crate) use progress::spinner;
+pub(crate) use progress::during;
 
 /// Options beyond the scene's own settings.
 #[derive(Clone, Copy, Debug, Default)]
@@ -223,10 +223,7 @@ pub fn bake_planned(
 ) -> Result<(Vec<ObjectSamples>, Option<DensityPlan>), RenderError> {
     let pool = thread_pool(scene.render.threads)?;
     pool.install(|| {
-        let b = spinner(progress, "prepare");
-        let prep = Prepared::new(scene);
-        b.finish_and_clear();
-        let prep = prep?;
+        let prep = during(progress, "prepare", || Prepared::new(scene))?;
         let plan = density::plan(&prep, &scene.render, None)?;
         warn_once(warn, plan.as_ref(), scene);
         let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
@@ -282,10 +279,7 @@ fn render_in_pool(
         .map_err(RenderError::Crop)?;
 
     let t = Instant::now();
-    let b = spinner(options.progress, "prepare");
-    let prep = Prepared::new(scene);
-    b.finish_and_clear();
-    let prep = prep?;
+    let prep = during(options.progress, "prepare", || Prepared::new(scene))?;
     let lighting = Lighting::new(&scene.lights, prep.occluders.as_ref(), prep.scale);
     timings.prepare = t.elapsed();
 

@@ -2,9 +2,9 @@
 //! irradiance, shading), the time alone for those that do not (loading the scene,
 //! preparing it: with a scanned mesh of millions of triangles, either can take a minute).
 //!
-//! On a terminal, a bar (or a spinner) redrawn in place. Anywhere else (a redirected stderr, a farm's job
-//! log) a bar's redraws would be noise, and silence until the end leaves whoever watches the
-//! log unable to tell a long render from a hung one. So there a phase that runs longer than
+//! On a terminal, a bar (or a spinner) redrawn in place. Anywhere else (a redirected stderr, a
+//! farm's job log) a bar's redraws would be noise, and silence until the end leaves whoever
+//! watches the log unable to tell a long render from a hung one. So there a phase that runs longer than
 //! [`LOG_INTERVAL`] writes one plain line per interval:
 //!
 //! ```text
@@ -46,10 +46,19 @@ pub(crate) fn bar(enabled: bool, len: u64, message: &'static str) -> ProgressBar
     bar
 }
 
+/// Runs `phase`, a phase without a count of its steps called `message`, under a [`spinner`]
+/// cleared when it returns, whether it succeeded or not.
+pub(crate) fn during<T>(enabled: bool, message: &'static str, phase: impl FnOnce() -> T) -> T {
+    let shown = spinner(enabled, message);
+    let result = phase();
+    shown.finish_and_clear();
+    result
+}
+
 /// A phase without a count of its steps, `message`: a spinner with the time elapsed on a
 /// terminal, a line every [`LOG_INTERVAL`] elsewhere (`lucent: load after 0:00:10`), nothing
-/// when `enabled` is false. Finish it with `finish_and_clear`, also when the phase fails.
-pub(crate) fn spinner(enabled: bool, message: &'static str) -> ProgressBar {
+/// when `enabled` is false.
+fn spinner(enabled: bool, message: &'static str) -> ProgressBar {
     if !enabled {
         return ProgressBar::hidden();
     }

@@ -258,11 +258,8 @@ fn merge(parts: &[ObjGroup], usemtl_names: &[String]) -> Result<ObjMesh, ObjErro
     })
 }
 
-/// Checks face-index ranges the way `tobj` resolves them, reporting the first bad one with its
-/// line. Counts of `v`, `vt`, `vn` so far resolve negative indices; the file's totals bound
-/// positive ones. Two passes over the text: the reader calls it only to find an error's line.
-pub(super) fn check_indices(text: &str) -> Result<(), ObjError> {
-    const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+/// How many `v`, `vt` and `vn` statements the text holds.
+pub(super) fn attribute_counts(text: &str) -> [usize; 3] {
     let mut totals = [0usize; 3];
     for line in text.lines() {
         match line.split_whitespace().next() {
@@ -272,6 +269,15 @@ pub(super) fn check_indices(text: &str) -> Result<(), ObjError> {
             _ => {}
         }
     }
+    totals
+}
+
+/// Checks face-index ranges the way `tobj` resolves them, reporting the first bad one with its
+/// line. Counts of `v`, `vt`, `vn` so far resolve negative indices; the file's totals bound
+/// positive ones. Two passes over the text: the reader calls it only to find an error's line.
+pub(super) fn check_indices(text: &str) -> Result<(), ObjError> {
+    const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    let totals = attribute_counts(text);
     let mut so_far = [0usize; 3];
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();

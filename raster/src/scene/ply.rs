@@ -303,7 +303,7 @@ fn list_bytes(header: &Header, layout: &MeshLayout) -> u64 {
         .saturating_add(count("face").saturating_mul(12))
 }
 
-/// The error for lists larger than memory.
+/// The error for lists the allocator refused to reserve after [`probe_lists`] granted them.
 fn out_of_memory(header: &Header, layout: &MeshLayout) -> PlyError {
     let refused = memory::OutOfMemory {
         bytes: list_bytes(header, layout),
@@ -317,7 +317,7 @@ fn out_of_memory(header: &Header, layout: &MeshLayout) -> PlyError {
 /// numbers becomes 12 bytes or more.
 fn probe_lists(header: &Header, layout: &MeshLayout) -> Result<(), PlyError> {
     memory::probe(list_bytes(header, layout), memory::PLY_LISTS)
-        .map_err(|_| out_of_memory(header, layout))
+        .map_err(|refused| at_line(0, refused.to_string()))
 }
 
 fn read_vertices(

@@ -263,12 +263,8 @@ fn index_error(text: &str) -> ObjError {
 /// [`index_error`] for a reader that holds at most `beyond` of each kind.
 fn index_error_beyond(text: &str, beyond: u64) -> ObjError {
     super::obj::check_indices(text).err().unwrap_or_else(|| {
-        let most = ["v", "vt", "vn"].map(|statement| {
-            text.lines()
-                .filter(|line| line.split_whitespace().next() == Some(statement))
-                .count() as u64
-        });
-        let message = if most.iter().any(|&n| n > beyond) {
+        let counts = super::obj::attribute_counts(text);
+        let message = if counts.iter().any(|&n| n as u64 > beyond) {
             format!(
                 "more than {beyond} vertices, texture coordinates or normals: beyond what the \
                  reader holds"

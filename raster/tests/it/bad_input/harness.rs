@@ -198,11 +198,12 @@ impl Sandbox {
                     out.insert(name, None);
                     walk(root, &path, out);
                 } else {
-                    let len = path.metadata().expect("a sandbox file's metadata").len();
+                    let meta = path.metadata().expect("a sandbox file's metadata");
+                    let len = meta.len();
                     let contents = if len > LARGE_FILE {
                         // Its length and time of modification: reading it twice per run cost
                         // seconds, and a run that rewrote it would change the time.
-                        let modified = path.metadata().and_then(|m| m.modified());
+                        let modified = meta.modified();
                         format!("{len} bytes, modified {modified:?}").into_bytes()
                     } else {
                         std::fs::read(&path).expect("read a sandbox file")
