@@ -72,6 +72,12 @@ pub const PLY_LISTS: Buffer = Buffer {
     remedy: "use a coarser mesh",
 };
 
+/// The vertices and triangles a glTF file's accessors hold.
+pub const GLTF_ACCESSORS: Buffer = Buffer {
+    what: "the glTF file's vertices and triangles",
+    remedy: "use a coarser mesh",
+};
+
 /// Peak bytes per triangle from the flattened scene to the placed samples: the shadow BVHs,
 /// the sampler's tiles and the samples' cells. Measured (peak resident set of a sphere of
 /// 1024 segments, 1 M triangles, and of a 7.8 M-triangle OBJ sphere): 239 and 211–218

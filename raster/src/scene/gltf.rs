@@ -23,6 +23,7 @@
 //! node hierarchy that is not a tree. Ignored: cameras, lights, skins, morph targets,
 //! animations, textures and every other attribute.
 
+use std::borrow::Cow;
 use std::fmt;
 use std::ops::Range;
 
@@ -33,6 +34,7 @@ use gltf::mesh::Mode;
 
 use super::mesh::finish_loaded_mesh;
 use super::model::Mesh;
+use crate::memory::{self, OutOfMemory};
 
 /// Why a glTF file could not be used.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,18 +93,27 @@ pub fn parse_gltf(
             "malformed GLB: its declared length {length} is shorter than its 12-byte header"
         )));
     }
-    let gltf::Gltf { document, mut blob } =
-        gltf::Gltf::from_slice_without_validation(bytes).map_err(malformed)?;
+    // A GLB's chunks are borrowed from `bytes`, not copied: the binary chunk of a scanned
+    // mesh can be gigabytes.
+    let (json, mut blob): (Cow<[u8]>, Option<Cow<[u8]>>) = if bytes.starts_with(b"glTF") {
+        let glb = gltf::Glb::from_slice(bytes).map_err(malformed)?;
+        (glb.json, glb.bin)
+    } else {
+        (Cow::Borrowed(bytes), None)
+    };
+    let gltf::Gltf { document, .. } =
+        gltf::Gltf::from_slice_without_validation(&json).map_err(malformed)?;
     check_position_accessors(document.as_json())?;
     let document = gltf::Document::from_json(document.into_json()).map_err(malformed)?;
-    let mut buffers = Vec::new();
+    let mut sources = Vec::new();
     for buffer in document.buffers() {
         let what = format!("buffer {}", buffer.index());
-        let mut data = match buffer.source() {
+        let data = match buffer.source() {
             gltf::buffer::Source::Bin => blob
                 .take()
                 .ok_or_else(|| fail(format!("{what} is the GLB binary chunk, which is missing")))?,
             gltf::buffer::Source::Uri(uri) => load_uri(uri, read_file)
+                .map(Cow::Owned)
                 .map_err(|why| fail(format!("{what} ({}): {why}", short(uri))))?,
         };
         if data.len() < buffer.length() {
@@ -112,11 +123,11 @@ pub fn parse_gltf(
                 data.len()
             )));
         }
-        // The buffer is its declared length: a view beyond it is an error even where the
-        // file holds more bytes (a GLB chunk's padding, or a URI's longer file).
-        data.truncate(buffer.length());
-        buffers.push(data);
+        sources.push((data, buffer.length()));
     }
+    // Each buffer is its declared length: a view beyond it is an error even where the file
+    // holds more bytes (a GLB chunk's padding, or a URI's longer file).
+    let buffers: Vec<&[u8]> = sources.iter().map(|(data, len)| &data[..*len]).collect();
     let scene = document
         .default_scene()
         .or_else(|| document.scenes().next())
@@ -271,7 +282,7 @@ struct Builder {
 impl Builder {
     fn add(
         &mut self,
-        buffers: &[Vec<u8>],
+        buffers: &[&[u8]],
         primitive: &gltf::Primitive,
         world: &DMat4,
     ) -> Result<(), String> {
@@ -310,7 +321,8 @@ impl Builder {
         }
         let indices = match primitive.indices() {
             Some(a) => read_indices(buffers, &a)?,
-            None => (0..n as u32).collect(),
+            None => memory::collect(n, 0..n as u32, memory::GLTF_ACCESSORS)
+                .map_err(|e| e.to_string())?,
         };
         if indices.len() % 3 != 0 {
             return Err(format!(
@@ -322,6 +334,14 @@ impl Builder {
             return Err(format!("index {bad} out of range ({n} vertices)"));
         }
 
+        reserve(&mut self.mesh.positions, n)?;
+        reserve(&mut self.mesh.triangles, indices.len() / 3)?;
+        if normals.is_some() {
+            reserve(&mut self.normals, n)?;
+        }
+        if uvs.is_some() {
+            reserve(&mut self.uvs, n)?;
+        }
         let linear = DMat3::from_mat4(*world);
         let mirrored = linear.determinant() < 0.0;
         let normal_matrix = linear.inverse().transpose();
@@ -367,6 +387,11 @@ impl Builder {
                 "the default scene has no triangles (a mesh needs at least one)",
             ));
         }
+        // Finishing copies the vertex lists (unused vertices dropped, normals made unit):
+        // asked for at once, so that a mesh that only just fitted is refused here rather
+        // than aborting there.
+        let vertex_bytes = 32 * self.mesh.positions.len() as u64;
+        memory::probe(vertex_bytes, memory::GLTF_ACCESSORS).map_err(|e| fail(e.to_string()))?;
         let mut mesh = self.mesh;
         mesh.uvs = self.all_uvs.then_some(self.uvs);
         let mesh =
@@ -378,20 +403,31 @@ impl Builder {
     }
 }
 
+/// Room for `n` more items in `v`, or the out-of-memory error as a message.
+fn reserve<T>(v: &mut Vec<T>, n: usize) -> Result<(), String> {
+    v.try_reserve(n).map_err(|_| {
+        OutOfMemory {
+            bytes: (n as u64).saturating_mul(size_of::<T>() as u64),
+            buffer: memory::GLTF_ACCESSORS,
+        }
+        .to_string()
+    })
+}
+
 /// The bytes of each element of `accessor`: checks the buffer view, stride, offset and count
-/// against the buffer, then returns the element slices (`size` bytes each).
+/// against the buffer, then returns the element slices (`size` bytes each, `count` of them).
 fn elements<'b>(
-    buffers: &'b [Vec<u8>],
+    buffers: &[&'b [u8]],
     accessor: &gltf::Accessor,
     size: usize,
-) -> Result<Vec<&'b [u8]>, String> {
+) -> Result<impl ExactSizeIterator<Item = &'b [u8]>, String> {
     if accessor.sparse().is_some() {
         return Err("sparse accessors are not supported".to_string());
     }
     let view = accessor
         .view()
         .ok_or("an accessor without a buffer view is not supported")?;
-    let buffer = buffers
+    let buffer: &'b [u8] = buffers
         .get(view.buffer().index())
         .ok_or("the buffer view's buffer is missing")?;
     let view_bytes = view
@@ -431,15 +467,14 @@ fn elements<'b>(
                 view_bytes.len()
             )
         })?;
+    // `count − 1` strides and one element: `count` chunks, each at least `size` long.
     let data = &view_bytes[accessor.offset()..end];
-    Ok((0..count)
-        .map(|i| &data[i * stride..i * stride + size])
-        .collect())
+    Ok(data.chunks(stride).map(move |e| &e[..size]))
 }
 
 /// An accessor of `N`-component floats (or, for `TEXCOORD_0`, normalised unsigned integers).
 fn read_floats<const N: usize>(
-    buffers: &[Vec<u8>],
+    buffers: &[&[u8]],
     accessor: &gltf::Accessor,
     what: &str,
 ) -> Result<Vec<[f32; N]>, String> {
@@ -470,23 +505,21 @@ fn read_floats<const N: usize>(
         ));
     }
     let data_type = accessor.data_type();
-    Ok(elements(buffers, accessor, N * component)?
-        .into_iter()
-        .map(|e| {
-            std::array::from_fn(|k| {
-                let c = &e[k * component..(k + 1) * component];
-                match data_type {
-                    DataType::U8 => f32::from(c[0]) / 255.0,
-                    DataType::U16 => f32::from(u16::from_le_bytes([c[0], c[1]])) / 65535.0,
-                    _ => f32::from_le_bytes([c[0], c[1], c[2], c[3]]),
-                }
-            })
+    let values = elements(buffers, accessor, N * component)?.map(|e| {
+        std::array::from_fn(|k| {
+            let c = &e[k * component..(k + 1) * component];
+            match data_type {
+                DataType::U8 => f32::from(c[0]) / 255.0,
+                DataType::U16 => f32::from(u16::from_le_bytes([c[0], c[1]])) / 65535.0,
+                _ => f32::from_le_bytes([c[0], c[1], c[2], c[3]]),
+            }
         })
-        .collect())
+    });
+    memory::collect(values.len(), values, memory::GLTF_ACCESSORS).map_err(|e| e.to_string())
 }
 
 /// An index accessor (unsigned byte, short or int scalars).
-fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor) -> Result<Vec<u32>, String> {
+fn read_indices(buffers: &[&[u8]], accessor: &gltf::Accessor) -> Result<Vec<u32>, String> {
     let data_type = accessor.data_type();
     if accessor.dimensions() != Dimensions::Scalar
         || !matches!(data_type, DataType::U8 | DataType::U16 | DataType::U32)
@@ -496,14 +529,12 @@ fn read_indices(buffers: &[Vec<u8>], accessor: &gltf::Accessor) -> Result<Vec<u3
             accessor.dimensions()
         ));
     }
-    Ok(elements(buffers, accessor, data_type.size())?
-        .into_iter()
-        .map(|c| match c.len() {
-            1 => u32::from(c[0]),
-            2 => u32::from(u16::from_le_bytes([c[0], c[1]])),
-            _ => u32::from_le_bytes([c[0], c[1], c[2], c[3]]),
-        })
-        .collect())
+    let indices = elements(buffers, accessor, data_type.size())?.map(|c| match c.len() {
+        1 => u32::from(c[0]),
+        2 => u32::from(u16::from_le_bytes([c[0], c[1]])),
+        _ => u32::from_le_bytes([c[0], c[1], c[2], c[3]]),
+    });
+    memory::collect(indices.len(), indices, memory::GLTF_ACCESSORS).map_err(|e| e.to_string())
 }
 
 #[cfg(test)]

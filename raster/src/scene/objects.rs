@@ -17,7 +17,7 @@ use super::mesh_file::{MESH_EXTENSIONS, MeshFileError, MeshFormat, parse_mesh_fi
 use super::model::{Mesh, Object};
 use super::obj::{ObjMesh, load_obj};
 use super::object_materials::{MaterialRef, MaterialTable, ObjGroups, split_by_material};
-use super::origin::{MAX_FILE_BYTES, MAX_MESH_FILE_BYTES, SceneOrigin};
+use super::origin::{MAX_MESH_FILE_BYTES, SceneOrigin};
 use super::sanity::{
     PositionIds, drop_coincident_triangles, normals_against_winding, orient_outward,
 };
@@ -288,20 +288,17 @@ fn load_mesh(
         ));
     };
     let path = origin.resolve(name);
-    let limit = if matches!(format, MeshFormat::Obj | MeshFormat::Ply) {
-        MAX_MESH_FILE_BYTES
-    } else {
-        MAX_FILE_BYTES
-    };
-    let bytes = origin.read_up_to(name, limit).map_err(|why| {
-        c.at(
-            SceneErrorKind::Io,
-            key,
-            file,
-            format!("cannot read mesh {}: {why}", path.display()),
-        )
-        .with_source(why)
-    })?;
+    let bytes = origin
+        .read_up_to(name, MAX_MESH_FILE_BYTES)
+        .map_err(|why| {
+            c.at(
+                SceneErrorKind::Io,
+                key,
+                file,
+                format!("cannot read mesh {}: {why}", path.display()),
+            )
+            .with_source(why)
+        })?;
     let located = |e: MeshFileError| {
         c.at(
             SceneErrorKind::Mesh,
@@ -316,12 +313,13 @@ fn load_mesh(
             .map(Loaded::Obj)
             .map_err(|e| located(MeshFileError::Obj(e)));
     }
-    // Files a mesh refers to (glTF buffers) are relative to the mesh file.
+    // Files a mesh refers to (glTF buffers, as large as the mesh) are relative to the mesh
+    // file.
     let dir = Path::new(name).parent().unwrap_or(Path::new(""));
     let mut read_file = |relative: &str| -> Result<Vec<u8>, String> {
         let scene_relative = dir.join(relative).to_string_lossy().into_owned();
         origin
-            .read(&scene_relative)
+            .read_up_to(&scene_relative, MAX_MESH_FILE_BYTES)
             .map(|b| b.into_owned())
             .map_err(|why| {
                 format!(

@@ -12,11 +12,12 @@ use std::sync::Mutex;
 
 use crate::memory;
 
-/// Largest file the loader reads (scene, material library, texture, glTF mesh): 1 GiB.
+/// Largest file the loader reads (scene, material library, texture, baked samples): 1 GiB.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
 
-/// Largest OBJ or PLY mesh file the loader reads: 64 GiB. OBJ text takes about 40 bytes a
-/// triangle, so a scanned mesh of 25 M triangles is already 1 GiB; a render needs about 250
+/// Largest mesh file (OBJ, PLY, glTF and its buffers) the loader reads: 64 GiB. OBJ text takes
+/// about 40 bytes a triangle, so a scanned mesh of 25 M triangles is already 1 GiB, and a
+/// binary glTF with normals and texture coordinates about 30 bytes; a render needs about 250
 /// bytes a triangle besides, so memory, checked before the file is read and again before its
 /// contents are parsed, is what bounds the size in practice.
 pub const MAX_MESH_FILE_BYTES: u64 = 1 << 36;
@@ -83,7 +84,8 @@ impl SceneOrigin {
         self.read_up_to(relative, MAX_FILE_BYTES)
     }
 
-    /// [`SceneOrigin::read`] with a limit of its own (an OBJ or PLY mesh: [`MAX_MESH_FILE_BYTES`]).
+    /// [`SceneOrigin::read`] with a limit of its own (a mesh and its glTF buffers:
+    /// [`MAX_MESH_FILE_BYTES`]).
     pub fn read_up_to(&self, relative: &str, limit: u64) -> Result<Cow<'_, [u8]>, std::io::Error> {
         match self {
             SceneOrigin::File(_) => read_limited(&self.resolve(relative), limit).map(Cow::Owned),

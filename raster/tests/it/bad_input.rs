@@ -14,6 +14,8 @@
 mod harness;
 
 mod flags;
+#[cfg(unix)]
+mod gltf_mesh;
 mod memory;
 mod obj;
 mod outputs;
