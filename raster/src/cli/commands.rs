@@ -359,12 +359,15 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
     check_outputs(&outputs, &inputs)?;
     let baked = match &args.samples_from {
         Some(path) => {
-            let (groups, provenance) =
-                read_baked_with_provenance(path).map_err(|e| e.to_string())?;
+            // Millions of baked samples take seconds to read and match: the load's progress.
+            let (groups, provenance) = during(!args.quiet, "load", || {
+                read_baked_with_provenance(path).map_err(|e| e.to_string())
+            })?;
             for warning in provenance.warnings(&scene, path) {
                 errln!("warning: {warning}");
             }
-            Some(render::match_baked(&scene, groups).map_err(|e| e.to_string())?)
+            let matched = during(!args.quiet, "load", || render::match_baked(&scene, groups));
+            Some(matched.map_err(|e| e.to_string())?)
         }
         None => None,
     };
