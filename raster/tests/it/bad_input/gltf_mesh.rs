@@ -5,11 +5,9 @@ use std::os::unix::fs::FileExt;
 
 use super::harness::{CONSTANT, Sandbox, render, scene};
 
-/// Writes `mesh.glb`: one triangle's positions at the start of a binary chunk of `bin_len`
-/// bytes, and, with `indices`, an accessor of that many unsigned-byte indices right after them
-/// (the first triangle 0 1 2, the rest zeros). Everything past the written bytes is sparse: no
-/// disk space and no time to write it.
-fn write_glb(sb: &Sandbox, bin_len: u64, indices: Option<u64>) {
+/// The glTF document of [`write_glb`]'s mesh, its one buffer `bin_len` bytes long (`uri`:
+/// where it lies, or the GLB's binary chunk for `None`).
+fn document(bin_len: u64, indices: Option<u64>, uri: Option<&str>) -> String {
     let mut views = vec![r#"{"buffer":0,"byteOffset":0,"byteLength":36}"#.to_string()];
     let mut accessors = vec![
         r#"{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[0.5,0.5,0.5]}"#
@@ -26,13 +24,46 @@ fn write_glb(sb: &Sandbox, bin_len: u64, indices: Option<u64>) {
         primitive.push_str(r#","indices":1"#);
     }
     primitive.push('}');
-    let mut json = format!(
-        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{primitive}]}}],"buffers":[{{"byteLength":{bin_len}}}],"bufferViews":[{}],"accessors":[{}]}}"#,
+    let uri = uri.map_or(String::new(), |u| format!(r#","uri":"{u}""#));
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{primitive}]}}],"buffers":[{{"byteLength":{bin_len}{uri}}}],"bufferViews":[{}],"accessors":[{}]}}"#,
         views.join(","),
         accessors.join(",")
     )
-    .into_bytes();
-    while json.len() % 4 != 0 {
+}
+
+/// The start of the buffer: one triangle's positions and, with indices, its indices 0 1 2.
+fn triangle(indices: Option<u64>) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    for corner in [[0.5f32, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.5]] {
+        for c in corner {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    if indices.is_some() {
+        bytes.extend_from_slice(&[0, 1, 2]);
+    }
+    bytes
+}
+
+/// Writes `bytes` to `name` in the sandbox and lengthens the file to `len` bytes, the rest
+/// sparse zeros: no disk space and no time to write them. The last byte is written for real,
+/// so that the length does not rest on `set_len` alone.
+fn write_sparse(sb: &Sandbox, name: &str, bytes: &[u8], len: u64) {
+    let path = sb.path(name);
+    std::fs::write(&path, bytes).unwrap();
+    let file = std::fs::File::options().write(true).open(&path).unwrap();
+    file.set_len(len).unwrap();
+    file.write_all_at(&[0], len - 1).unwrap();
+    assert_eq!(file.metadata().unwrap().len(), len);
+}
+
+/// Writes `mesh.glb`: one triangle's positions at the start of a binary chunk of `bin_len`
+/// bytes, and, with `indices`, an accessor of that many unsigned-byte indices right after them
+/// (the first triangle 0 1 2, the rest zeros).
+fn write_glb(sb: &Sandbox, bin_len: u64, indices: Option<u64>) {
+    let mut json = document(bin_len, indices, None).into_bytes();
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let bin_len = bin_len.next_multiple_of(4);
@@ -45,22 +76,8 @@ fn write_glb(sb: &Sandbox, bin_len: u64, indices: Option<u64>) {
     bytes.extend_from_slice(&json);
     bytes.extend_from_slice(&u32::try_from(bin_len).unwrap().to_le_bytes());
     bytes.extend_from_slice(b"BIN\0");
-    let bin_at = bytes.len() as u64;
-    for corner in [[0.5f32, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.5]] {
-        for c in corner {
-            bytes.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    if indices.is_some() {
-        bytes.extend_from_slice(&[0, 1, 2]);
-    }
-    let path = sb.path("mesh.glb");
-    std::fs::write(&path, &bytes).unwrap();
-    let file = std::fs::File::options().write(true).open(&path).unwrap();
-    file.set_len(bin_at + bin_len).unwrap();
-    assert_eq!(file.metadata().unwrap().len(), total);
-    // The last byte written for real, so that the file's length does not rest on `set_len`.
-    file.write_all_at(&[0], total - 1).unwrap();
+    bytes.extend_from_slice(&triangle(indices));
+    write_sparse(sb, "mesh.glb", &bytes, total);
 }
 
 /// A binary glTF of more than 1 GiB (the limit of the files a scene names other than meshes)
@@ -93,4 +110,22 @@ fn glb_accessors_larger_than_memory_are_refused() {
              for the glTF file's vertices and triangles (use a coarser mesh, or free memory)",
         ],
     );
+}
+
+/// A `.gltf` whose buffer file is more than 1 GiB is read: the buffers a glTF names are as
+/// large as the mesh.
+#[test]
+#[cfg(target_pointer_width = "64")]
+fn gltf_buffer_beyond_one_gib_is_read() {
+    let sb = Sandbox::with_scene(
+        "gltf-bin-beyond-1gib",
+        &scene("mesh = \"mesh.gltf\"", CONSTANT),
+    );
+    let len = (1 << 30) + (1 << 20);
+    sb.write(
+        "mesh.gltf",
+        document(len, None, Some("mesh.bin")).as_bytes(),
+    );
+    write_sparse(&sb, "mesh.bin", &triangle(None), len);
+    sb.succeeds(&render(&["--samples", "50"]));
 }
