@@ -72,6 +72,12 @@ pub const PLY_LISTS: Buffer = Buffer {
     remedy: "use a coarser mesh",
 };
 
+/// A glTF file's parsed JSON, with the buffers embedded in it as data URIs.
+pub const GLTF_JSON: Buffer = Buffer {
+    what: "the glTF file's JSON and the buffers embedded in it",
+    remedy: "keep large buffers in a .bin file or use a .glb",
+};
+
 /// The vertices and triangles a glTF file's accessors hold.
 pub const GLTF_ACCESSORS: Buffer = Buffer {
     what: "the glTF file's vertices and triangles",

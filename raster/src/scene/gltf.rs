@@ -101,6 +101,10 @@ pub fn parse_gltf(
     } else {
         (Cow::Borrowed(bytes), None)
     };
+    // The parsed document holds a copy of every string, data URIs included, and their decoded
+    // buffers come on top: about twice the JSON, asked for at once before parsing, where the
+    // parser's own allocations would abort.
+    memory::probe(2 * json.len() as u64, memory::GLTF_JSON).map_err(|e| fail(e.to_string()))?;
     let gltf::Gltf { document, .. } =
         gltf::Gltf::from_slice_without_validation(&json).map_err(malformed)?;
     check_position_accessors(document.as_json())?;

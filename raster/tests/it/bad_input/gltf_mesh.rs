@@ -129,3 +129,32 @@ fn gltf_buffer_beyond_one_gib_is_read() {
     write_sparse(&sb, "mesh.bin", &triangle(None), len);
     sb.succeeds(&render(&["--samples", "50"]));
 }
+
+/// A `.gltf` whose buffer is embedded as a data URI of 300 MB is refused under 0.75 GiB of
+/// address space before its JSON is parsed (the parser's copy of the string and the decoded
+/// bytes would need about twice the text), instead of aborting inside the parser.
+#[test]
+#[cfg(target_os = "linux")]
+fn gltf_json_larger_than_memory_is_refused_before_it_is_parsed() {
+    let sb = Sandbox::with_scene("gltf-json", &scene("mesh = \"mesh.gltf\"", CONSTANT))
+        .with_address_space(3 << 18);
+    let encoded = 300_000_000;
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        "A".repeat(encoded)
+    );
+    sb.write(
+        "mesh.gltf",
+        document(encoded as u64 / 4 * 3, None, Some(&uri)).as_bytes(),
+    );
+    sb.fails(
+        &["scene.toml"],
+        1,
+        &[
+            "object[0].mesh",
+            "mesh.gltf: out of memory: could not allocate 572.2 MiB for the glTF file's JSON and \
+             the buffers embedded in it (keep large buffers in a .bin file or use a .glb, or \
+             free memory)",
+        ],
+    );
+}
