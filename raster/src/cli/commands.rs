@@ -359,14 +359,18 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
     check_outputs(&outputs, &inputs)?;
     let baked = match &args.samples_from {
         Some(path) => {
-            // Millions of baked samples take seconds to read and match: the load's progress.
-            let (groups, provenance) = during(!args.quiet, "load", || {
-                read_baked_with_provenance(path).map_err(|e| e.to_string())
-            })?;
-            for warning in provenance.warnings(&scene, path) {
+            // Millions of baked samples take seconds to read and match: one phase under the
+            // load's progress, its warnings printed once it is cleared.
+            let (warnings, matched) = during(!args.quiet, "load", || {
+                read_baked_with_provenance(path).map(|(groups, provenance)| {
+                    let warnings = provenance.warnings(&scene, path);
+                    (warnings, render::match_baked(&scene, groups))
+                })
+            })
+            .map_err(|e| e.to_string())?;
+            for warning in warnings {
                 errln!("warning: {warning}");
             }
-            let matched = during(!args.quiet, "load", || render::match_baked(&scene, groups));
             Some(matched.map_err(|e| e.to_string())?)
         }
         None => None,

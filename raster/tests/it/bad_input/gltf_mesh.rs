@@ -1,8 +1,6 @@
 //! Binary glTF meshes at the sizes of scans: files beyond 1 GiB read, accessors beyond memory
 //! refused.
 
-use std::os::unix::fs::FileExt;
-
 use super::harness::{CONSTANT, Sandbox, render, scene};
 
 /// The glTF document of [`write_glb`]'s mesh, its one buffer `bin_len` bytes long (`uri`:
@@ -46,18 +44,6 @@ fn triangle(indices: Option<u64>) -> Vec<u8> {
     bytes
 }
 
-/// Writes `bytes` to `name` in the sandbox and lengthens the file to `len` bytes, the rest
-/// sparse zeros: no disk space and no time to write them. The last byte is written for real,
-/// so that the length does not rest on `set_len` alone.
-fn write_sparse(sb: &Sandbox, name: &str, bytes: &[u8], len: u64) {
-    let path = sb.path(name);
-    std::fs::write(&path, bytes).unwrap();
-    let file = std::fs::File::options().write(true).open(&path).unwrap();
-    file.set_len(len).unwrap();
-    file.write_all_at(&[0], len - 1).unwrap();
-    assert_eq!(file.metadata().unwrap().len(), len);
-}
-
 /// Writes `mesh.glb`: one triangle's positions at the start of a binary chunk of `bin_len`
 /// bytes, and, with `indices`, an accessor of that many unsigned-byte indices right after them
 /// (the first triangle 0 1 2, the rest zeros).
@@ -77,7 +63,7 @@ fn write_glb(sb: &Sandbox, bin_len: u64, indices: Option<u64>) {
     bytes.extend_from_slice(&u32::try_from(bin_len).unwrap().to_le_bytes());
     bytes.extend_from_slice(b"BIN\0");
     bytes.extend_from_slice(&triangle(indices));
-    write_sparse(sb, "mesh.glb", &bytes, total);
+    sb.write_sparse("mesh.glb", &bytes, total);
 }
 
 /// A binary glTF of more than 1 GiB (the limit of the files a scene names other than meshes)
@@ -126,7 +112,7 @@ fn gltf_buffer_beyond_one_gib_is_read() {
         "mesh.gltf",
         document(len, None, Some("mesh.bin")).as_bytes(),
     );
-    write_sparse(&sb, "mesh.bin", &triangle(None), len);
+    sb.write_sparse("mesh.bin", &triangle(None), len);
     sb.succeeds(&render(&["--samples", "50"]));
 }
 

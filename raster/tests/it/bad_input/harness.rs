@@ -172,6 +172,18 @@ impl Sandbox {
         std::fs::write(self.path(name), bytes).expect("write a sandbox file");
     }
 
+    /// Writes `head` into the sandbox as `name` and lengthens the file to `len` bytes: the rest
+    /// reads as zeros without being written (a sparse file: no disk space, no time), so that
+    /// tests can hand the binary files of a gibibyte and more.
+    pub fn write_sparse(&self, name: &str, head: &[u8], len: u64) {
+        self.write(name, head);
+        std::fs::File::options()
+            .write(true)
+            .open(self.path(name))
+            .and_then(|f| f.set_len(len))
+            .expect("lengthen a sandbox file");
+    }
+
     /// Reads a file of the sandbox.
     pub fn read(&self, name: &str) -> Vec<u8> {
         std::fs::read(self.path(name)).expect("read a sandbox file")

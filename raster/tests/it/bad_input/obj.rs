@@ -48,15 +48,9 @@ fn valid_obj_renders() {
 /// Writes the octahedron as `mesh.obj`, its last line a comment of NUL bytes that makes the file
 /// `len` bytes long. The file is sparse: no disk space and no time to write it.
 pub(super) fn write_padded_octahedron(sb: &Sandbox, len: u64) {
-    let path = sb.path("mesh.obj");
     let mut text = OCTAHEDRON.to_string();
     text.push('#');
-    std::fs::write(&path, text).unwrap();
-    std::fs::File::options()
-        .write(true)
-        .open(&path)
-        .and_then(|f| f.set_len(len))
-        .unwrap();
+    sb.write_sparse("mesh.obj", text.as_bytes(), len);
 }
 
 /// An OBJ of more than 1 GiB (the limit of other files a scene reads) is read: a scanned mesh

@@ -34,8 +34,8 @@ fn write_ply(sb: &Sandbox, vertices: u64, padding: u64) {
     file.write_all_at(&face, face_at).unwrap();
 }
 
-/// A PLY of more than 1 GiB (the limit of the files a scene names other than OBJ and PLY
-/// meshes) is read.
+/// A PLY of more than 1 GiB (the limit of the files a scene names other than meshes) is
+/// read.
 #[test]
 #[cfg(target_pointer_width = "64")]
 fn ply_beyond_one_gib_is_read() {
