@@ -234,6 +234,8 @@ pub use simd::SimdLanes;
 mod array;
 #[cfg(feature = "simd")]
 pub use array::ArrayLanes;
+#[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
+pub(crate) use array::permute_avx2;
 
 #[cfg(feature = "simd")]
 mod simd {

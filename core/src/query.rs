@@ -14,7 +14,11 @@ use core::str::FromStr;
 
 use glam::{DVec3, Vec3};
 
-use crate::cache::traverse::{EDGE_AWARE, FLUX_HEADROOM, HIERARCHICAL, LOCAL_GLOBAL, Params, Sums};
+#[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
+use crate::cache::traverse::InRegisters;
+use crate::cache::traverse::{
+    Compaction, EDGE_AWARE, FLUX_HEADROOM, HIERARCHICAL, LOCAL_GLOBAL, LaneByLane, Params, Sums,
+};
 use crate::cache::{self, IrradianceCache};
 use crate::error::ParseMethodError;
 use crate::kernel::Kernel;
@@ -307,8 +311,9 @@ impl IrradianceCache {
         stats.query();
         check_point(point)?;
         // `ArrayLanes` inlines the whole traversal here (`Lanes::INLINE_TRAVERSAL`), so that all
-        // of it is compiled for AVX2.
-        Ok(self.run::<crate::lanes::ArrayLanes, QueryStats>(plan, point, stats))
+        // of it is compiled for AVX2, the closure too: there `vpermps` is safe to call.
+        let compaction = InRegisters(|values, order| crate::lanes::permute_avx2(values, order));
+        Ok(self.run::<crate::lanes::ArrayLanes, QueryStats, _>(plan, point, stats, compaction))
     }
 
     /// [`IrradianceCache::query_with_stats`] with an explicit lane type (SIMD or scalar): for
@@ -332,7 +337,7 @@ impl IrradianceCache {
         }
         check_point(point)?;
         let plan = self.plan(profile, local, settings)?;
-        Ok(self.run::<L, S>(&plan, point, stats))
+        Ok(self.run::<L, S, _>(&plan, point, stats, LaneByLane))
     }
 
     /// Checks `settings` and `local` and computes what every query of `profile` on this cache
@@ -447,17 +452,18 @@ impl IrradianceCache {
     ) -> Result<Exitance, QueryError> {
         stats.query();
         check_point(point)?;
-        Ok(self.run::<DefaultLanes, S>(plan, point, stats))
+        Ok(self.run::<DefaultLanes, S, _>(plan, point, stats, LaneByLane))
     }
 
     /// The query proper, its inputs checked. Always inlined, so that
     /// [`IrradianceCache::query_planned_avx2`] compiles all of it for AVX2.
     #[inline(always)]
-    fn run<L: Lanes, S: StatsSink>(
+    fn run<L: Lanes, S: StatsSink, K: Compaction>(
         &self,
         plan: &QueryPlan,
         point: &ShadingPoint,
         stats: &mut S,
+        compaction: K,
     ) -> Exitance {
         let profile = &plan.profile;
         let local_integral = plan.local.k();
@@ -484,7 +490,9 @@ impl IrradianceCache {
                 }
             }
             Method::Hierarchical => {
-                let sums = cache::traverse::<L, S, HIERARCHICAL>(self, profile, x, &params, stats);
+                let sums = cache::traverse::<L, S, K, HIERARCHICAL>(
+                    self, profile, x, &params, stats, compaction,
+                );
                 Exitance {
                     total: sums.global,
                     global: sums.global,
@@ -492,11 +500,15 @@ impl IrradianceCache {
                 }
             }
             Method::LocalGlobal => {
-                let sums = cache::traverse::<L, S, LOCAL_GLOBAL>(self, profile, x, &params, stats);
+                let sums = cache::traverse::<L, S, K, LOCAL_GLOBAL>(
+                    self, profile, x, &params, stats, compaction,
+                );
                 split_result(sums, e, local_integral)
             }
             Method::EdgeAware | Method::EdgeRefined => {
-                let sums = cache::traverse::<L, S, EDGE_AWARE>(self, profile, x, &params, stats);
+                let sums = cache::traverse::<L, S, K, EDGE_AWARE>(
+                    self, profile, x, &params, stats, compaction,
+                );
                 let refine = plan.method == Method::EdgeRefined
                     && !uniform_within(sums.irradiance_range, e, EDGE_THRESHOLD);
                 // N10: the shading point joins the kernel-weighted average at r = 0 with weight

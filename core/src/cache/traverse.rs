@@ -91,6 +91,16 @@
 //! baseline lanes at every ε, for both JB02 and N10, with the same bits; the baseline path's
 //! code is unchanged (callgrind: the same instruction count within 1%).
 //!
+//! One instruction has no portable form the compiler would emit: the variable permutation
+//! (`vpermps`) that moves a batch's kept lanes to the front of a term buffer. The AVX2 path
+//! passes it in as a closure ([`Compaction`]): a closure made inside the `#[target_feature]`
+//! function is compiled for AVX2 too, so the intrinsic is safe to call there, and the generic
+//! code only calls the closure. Moved lane by lane through memory, the compaction had taken
+//! about a fifth of a lookup; with `vpermps` a lookup costs 6–7% less (BENCHMARKS.md, "The
+//! floor"). Tried: appending in registers (the pending entries blended with the permuted new
+//! ones, every store a whole aligned half) was 4–5% slower than that: the compiler turned the
+//! blend and store into a masked store (`vmaskmovps`), which the next load cannot forward from.
+//!
 //! In the split modes each sample term gets the kernel weight w(r): the global sum gets
 //! (1 − w)·Rd·flux and, for N10, the local irradiance gets w·Rd·flux over w·Rd·A. Batches
 //! entirely beyond α skip the kernel. Modes are const generics, so each is compiled without the
@@ -185,6 +195,50 @@ const fn compact_table() -> [[u8; LANES]; 256] {
 }
 static COMPACT: [[u8; LANES]; 256] = compact_table();
 
+/// How [`Buffer::append`] moves the kept lanes of a batch to the front.
+pub(crate) trait Compaction: Copy {
+    /// True: [`Compaction::permute`] moves a whole column in registers, and every append
+    /// writes eight entries per column. False: the lanes are moved one by one through memory
+    /// (the baseline lanes: SSE2 has no variable permutation across eight lanes).
+    const IN_REGISTERS: bool;
+    /// Lane i of the result is lane `order`'s byte i (little-endian, each < 8) of `values`.
+    fn permute(self, values: [f32; LANES], order: u64) -> [f32; LANES];
+}
+
+/// Lane by lane, through memory: any instruction set.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneByLane;
+
+impl Compaction for LaneByLane {
+    const IN_REGISTERS: bool = false;
+    #[inline(always)]
+    fn permute(self, values: [f32; LANES], order: u64) -> [f32; LANES] {
+        let order = order.to_le_bytes();
+        let mut moved = [0.0; LANES];
+        for i in 0..LANES {
+            moved[i] = values[(order[i] & 7) as usize];
+        }
+        moved
+    }
+}
+
+/// A permutation in registers (AVX2's `vpermps`, [`crate::lanes::permute_avx2`]), given as a
+/// closure: made inside the one `#[target_feature(enable = "avx2")]` function, the closure is
+/// compiled for AVX2 too, so the intrinsic is safe to call there, and the generic traversal
+/// only calls the closure.
+#[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct InRegisters<F>(pub F);
+
+#[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
+impl<F: Fn([f32; LANES], u64) -> [f32; LANES] + Copy> Compaction for InRegisters<F> {
+    const IN_REGISTERS: bool = true;
+    #[inline(always)]
+    fn permute(self, values: [f32; LANES], order: u64) -> [f32; LANES] {
+        (self.0)(values, order)
+    }
+}
+
 /// Pending terms, `C` columns in structure-of-arrays form.
 struct Buffer<const C: usize> {
     columns: [[f32; BUFFER]; C],
@@ -206,14 +260,20 @@ impl<const C: usize> Buffer<C> {
     /// overwritten by the next append or masked when evaluated. The first version looped over
     /// the set bits of `keep` and stored lane by lane, reloading `len` after every store.
     #[inline(always)]
-    fn append<L: Lanes>(&mut self, keep: Mask, values: [L; C]) -> bool {
+    fn append<L: Lanes, K: Compaction>(&mut self, keep: Mask, values: [L; C], by: K) -> bool {
         let order = &COMPACT[(keep.0 & 0xff) as usize];
         let len = self.len.min(LANES);
         let n = keep.0.count_ones() as usize;
         // Index loops rather than iterator adapters or closures here and in the rest of the
         // traversal: the AVX2 path inlines all of it into one function, and there the compiler
         // left such helpers as out-of-line calls, compiled without AVX2.
-        if n <= LANES / 2 {
+        if K::IN_REGISTERS {
+            let order = u64::from_le_bytes(*order);
+            for c in 0..C {
+                let moved = by.permute(values[c].to_array(), order);
+                self.columns[c][len..len + LANES].copy_from_slice(&moved);
+            }
+        } else if n <= LANES / 2 {
             for c in 0..C {
                 let v = values[c].to_array();
                 let dst = &mut self.columns[c][len..len + LANES / 2];
@@ -270,7 +330,7 @@ impl<const C: usize> Buffer<C> {
 /// the mean relative error.
 const DISC_AREA_PER_TRACE: f32 = 2.0 * core::f32::consts::PI;
 
-struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
+struct Walker<'a, L: Lanes, S: StatsSink, K: Compaction, const MODE: u8> {
     cache: &'a IrradianceCache,
     profile: &'a Profile,
     kernel: Kernel,
@@ -296,9 +356,11 @@ struct Walker<'a, L: Lanes, S: StatsSink, const MODE: u8> {
     deferred: [u32; DEFERRED],
     deferred_len: usize,
     stats: &'a mut S,
+    /// How the term buffers are appended to.
+    compaction: K,
 }
 
-impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
+impl<L: Lanes, S: StatsSink, K: Compaction, const MODE: u8> Walker<'_, L, S, K, MODE> {
     /// Folds the lane sums into the double-precision totals every [`FOLD_BATCHES`] batches.
     #[inline(always)]
     fn count_batch(&mut self) {
@@ -478,7 +540,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
         };
         if self
             .samples
-            .append(keep, [r2, flux[0], flux[1], flux[2], area])
+            .append(keep, [r2, flux[0], flux[1], flux[2], area], self.compaction)
         {
             self.evaluate_samples(LANES);
             self.samples.consume();
@@ -626,6 +688,7 @@ impl<L: Lanes, S: StatsSink, const MODE: u8> Walker<'_, L, S, MODE> {
                 if self.aggregates.append(
                     aggregate,
                     [dist2, flux[0], flux[1], flux[2], q, trace, cross, trace_sq],
+                    self.compaction,
                 ) {
                     self.evaluate_aggregates(LANES);
                     self.aggregates.consume();
@@ -730,41 +793,44 @@ fn lanes_at<L: Lanes>(column: &[f32], first: usize) -> L {
 /// Runs one traversal in mode `MODE` for the shading point `x`: out of line, unless the lane
 /// type inlines the whole traversal into its caller ([`Lanes::INLINE_TRAVERSAL`]).
 #[inline(always)]
-pub(crate) fn traverse<L: Lanes, S: StatsSink, const MODE: u8>(
+pub(crate) fn traverse<L: Lanes, S: StatsSink, K: Compaction, const MODE: u8>(
     cache: &IrradianceCache,
     profile: &Profile,
     x: Vec3,
     params: &Params,
     stats: &mut S,
+    compaction: K,
 ) -> Sums {
     if L::INLINE_TRAVERSAL {
-        walk::<L, S, MODE>(cache, profile, x, params, stats)
+        walk::<L, S, K, MODE>(cache, profile, x, params, stats, compaction)
     } else {
-        walk_out_of_line::<L, S, MODE>(cache, profile, x, params, stats)
+        walk_out_of_line::<L, S, K, MODE>(cache, profile, x, params, stats, compaction)
     }
 }
 
 #[inline(never)]
-fn walk_out_of_line<L: Lanes, S: StatsSink, const MODE: u8>(
+fn walk_out_of_line<L: Lanes, S: StatsSink, K: Compaction, const MODE: u8>(
     cache: &IrradianceCache,
     profile: &Profile,
     x: Vec3,
     params: &Params,
     stats: &mut S,
+    compaction: K,
 ) -> Sums {
-    walk::<L, S, MODE>(cache, profile, x, params, stats)
+    walk::<L, S, K, MODE>(cache, profile, x, params, stats, compaction)
 }
 
 #[inline(always)]
-fn walk<L: Lanes, S: StatsSink, const MODE: u8>(
+fn walk<L: Lanes, S: StatsSink, K: Compaction, const MODE: u8>(
     cache: &IrradianceCache,
     profile: &Profile,
     x: Vec3,
     params: &Params,
     stats: &mut S,
+    compaction: K,
 ) -> Sums {
     let zero = [L::splat(0.0); 3];
-    let mut walker = Walker::<L, S, MODE> {
+    let mut walker = Walker::<L, S, K, MODE> {
         cache,
         profile,
         kernel: params.kernel,
@@ -783,6 +849,7 @@ fn walk<L: Lanes, S: StatsSink, const MODE: u8>(
         deferred: [0; DEFERRED],
         deferred_len: 0,
         stats,
+        compaction,
     };
     walker.run(params);
     walker.fold();
