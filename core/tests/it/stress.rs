@@ -818,6 +818,16 @@ fn overflowing_totals_are_rejected() {
             "a million areas of 1e33",
             (0..1_000_000).map(|_| one(1e33, 0.0)).collect(),
         ),
+        // Beyond f32::MAX by less than half its ulp: the total rounds to f32::MAX, but it is
+        // not at most f32::MAX, as documented.
+        (
+            "an area just beyond f32::MAX",
+            vec![one(f32::MAX, 0.0), one(1e30, 0.0)],
+        ),
+        (
+            "a flux just beyond f32::MAX",
+            vec![one(1.0, f32::MAX), one(1.0, 1e30)],
+        ),
     ];
     for (what, samples) in cases {
         match IrradianceCache::build(&samples) {
@@ -838,9 +848,12 @@ fn overflowing_totals_are_rejected() {
             }
         }
     }
-    // Just below the edge: a total area of 3e38 is fine.
+    // Just below the edge: a total area of 3e38 is fine, and so is exactly f32::MAX.
     let cache = IrradianceCache::build(&[one(1.5e38, 1e-38), one(1.5e38, 1e-38)]).unwrap();
     cache.validate().unwrap();
+    let cache = IrradianceCache::build(&[one(f32::MAX, 0.0), one(0.0, 1.0)]).unwrap();
+    cache.validate().unwrap();
+    assert_eq!(cache.total_area(), f32::MAX);
 }
 
 /// The ℓ → 0 limit of a rendered quantity: on a uniformly lit plane (spacing h = 0.05,
