@@ -45,6 +45,10 @@
 //!    where x lies in a node whose centroid is beyond 1.8·10¹⁹, whose squared distance
 //!    overflows (`crash-centroid-distance-squared-overflows`: the unlit node holding x was
 //!    pruned as far, and E_loc lost x's own sample).
+//! 7. On a CPU with AVX2, every query of 4 (and every refusal of a non-finite point) gives the
+//!    same bits and takes the same steps (`QueryStats`) on the AVX2 build of the traversal as
+//!    on the baseline lanes: the two paths differ in how they compile the same operations,
+//!    and in the AVX2 path's lane permutation (`vpermps`) for the term buffers.
 //!
 //! Rounding allowance: every query sums non-negative terms in f32 lanes, each lane adding at
 //! most ⌈n/8⌉ + 16 terms, so the relative error is at most about (n/8 + 16)·2⁻²⁴ (the classical
@@ -54,10 +58,12 @@
 use lucent_core::error::QueryError;
 use lucent_core::glam::{DVec3, Vec3};
 use lucent_core::internals::{exhaustive_edge_aware, exhaustive_local_global, exhaustive_sum};
+use lucent_core::stats::QueryStats;
 use lucent_core::{
     Distance, Exitance, IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile,
     QuerySettings, Sample, ShadingPoint,
 };
+use lucent_raster::render::simd::Avx2;
 
 use super::input::Input;
 
@@ -236,6 +242,12 @@ fn assert_sane(what: &str, m: &Exitance, representable: bool) {
     }
 }
 
+/// Every field of an exitance, as bits.
+fn exitance_bits(e: &Exitance) -> ([[u32; 3]; 4], bool) {
+    let bits = [e.total, e.local, e.global, e.local_irradiance];
+    (bits.map(|v| v.to_array().map(f32::to_bits)), e.refine)
+}
+
 /// The property of the fuzz target `cache_query_matches_exhaustive` (see the module docs);
 /// panics when it fails.
 pub fn cache_query_matches_exhaustive(data: &[u8]) {
@@ -292,6 +304,7 @@ pub fn cache_query_matches_exhaustive(data: &[u8]) {
         abs: 1e-25 * bound + 1e-37,
     };
 
+    let avx2 = Avx2::detect();
     for &(place, e) in &case.queries {
         let x = match place {
             Place::At(x) => x,
@@ -312,7 +325,24 @@ pub fn cache_query_matches_exhaustive(data: &[u8]) {
             epsilon,
             cull_tolerance,
         };
-        let query = |s: QuerySettings| cache.query(&profile, &point, local, &s);
+        let query = |s: QuerySettings| {
+            let mut counts = QueryStats::default();
+            let got = cache.query_with_stats(&profile, &point, local, &s, &mut counts);
+            if let Some(avx2) = avx2 {
+                let mut avx2_counts = QueryStats::default();
+                let other = avx2.query(&cache, &profile, &point, local, &s, &mut avx2_counts);
+                assert_eq!(
+                    got.as_ref().map(exitance_bits),
+                    other.as_ref().map(exitance_bits),
+                    "{} at {x}, ε {}, t {}: the AVX2 path's bits differ ({got:?} vs {other:?})",
+                    s.method.name(),
+                    s.epsilon,
+                    s.cull_tolerance
+                );
+                assert_eq!(counts, avx2_counts, "the AVX2 path took other steps at {x}");
+            }
+            got
+        };
         if !x.is_finite() {
             for method in Method::ALL {
                 let got = query(settings(method, 0.0, 0.0));
