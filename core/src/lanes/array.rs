@@ -14,6 +14,11 @@
 //! compiled for AVX2, in the renderer's `render::simd`). Loops, not `core::array::from_fn` or
 //! `map`: inlined into the AVX2 traversal, those were left as out-of-line calls, compiled
 //! without AVX2.
+//!
+//! One operation has no loop the compiler turns into its instruction: a variable permutation
+//! of the lanes. [`permute_avx2`] calls AVX2's `vpermps` directly (safe inside
+//! `#[target_feature(enable = "avx2")]` code); the traversal gets it as a closure made in the
+//! AVX2 function (`Compaction` in `cache/traverse.rs`).
 
 use core::ops::{Add, Div, Mul, Sub};
 
