@@ -1,7 +1,7 @@
 //! A Monte Carlo reference for diffusion profiles: an analogue random walk of photons in a
 //! homogeneous semi-infinite medium, scored as the radial profile of the light that comes
 //! back out. Diffusion models (the classical dipole and its successors) are measured against
-//! it ([`compare`]).
+//! it ([`compare()`]).
 //!
 //! **What it simulates.** The medium fills z > 0. Lengths are in units of the mean free path
 //! ℓ_u = 1/σ_t′, so the reduced extinction is σ_t′ = 1, and scattering is isotropic with the

@@ -29,7 +29,7 @@ const INSET_ZOOM: u32 = 3;
 /// Inset marker colour.
 const MARKER: [u8; 3] = [255, 220, 0];
 
-/// Writes a scene's charts ([`write_charts`](super::write_charts)) and, when the sheet's images are all there,
+/// Writes a scene's charts ([`super::write_charts`]) and, when the sheet's images are all there,
 /// `<scene>-figure1.png`; returns the contact sheet's caption (Markdown) for the report.
 pub fn write_scene_figures(
     config: &BenchConfig,

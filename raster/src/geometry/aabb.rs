@@ -103,7 +103,7 @@ const TINY_DIR: f32 = 1e-30;
 /// `|inv_dir|` from [`safe_inverse`] at or above which an axis is parallel (see [`TINY_DIR`]).
 const PARALLEL_INV: f32 = 1.0 / TINY_DIR;
 
-/// The reciprocal direction used by [`slab_test`], finite in every component.
+/// The reciprocal direction used by [`RayLanes::slab_test`], finite in every component.
 pub(crate) fn safe_inverse(dir: Vec3) -> Vec3A {
     let fix = |d: f32| {
         if d.abs() < TINY_DIR {
