@@ -6,8 +6,8 @@
 //! restricted Voronoi diagram ([`crate::sampling::voronoi_areas`]): the areas of an object sum
 //! to its surface area, and a sample that stands closer to its neighbours weighs less, so the
 //! density fluctuations of the blue noise and the denser samples near a surface's border do not
-//! become exitance error as they did with equal areas (total / N, as in JB02). Each sample then moves
-//! to its cell's centroid (on the surface, with the normal there), so that the sum of area ×
+//! become exitance error as they did with equal areas (total / N, as in JB02). Each sample then
+//! moves to its cell's centroid (on the surface, with the normal there), so that the sum of area ×
 //! integrand is exact for integrands linear over each cell rather than constant. Cells are per
 //! object (a sample never takes area of another object), and so are the caches: light does not
 //! diffuse from one object into another.
