@@ -109,29 +109,50 @@ pub fn parse_gltf(
         gltf::Gltf::from_slice_without_validation(&json).map_err(malformed)?;
     check_position_accessors(document.as_json())?;
     let document = gltf::Document::from_json(document.into_json()).map_err(malformed)?;
+    // The bytes behind the buffers, each read once: exporters may name one file in several
+    // buffers (a mesh's attributes and its indices, say), and a scanned mesh's file is large.
+    let mut contents: Vec<Cow<[u8]>> = Vec::new();
+    let mut read_uris: Vec<(&str, usize)> = Vec::new();
+    // Per buffer: its index in `contents` and its declared length.
     let mut sources = Vec::new();
     for buffer in document.buffers() {
         let what = format!("buffer {}", buffer.index());
-        let data = match buffer.source() {
-            gltf::buffer::Source::Bin => blob
-                .take()
-                .ok_or_else(|| fail(format!("{what} is the GLB binary chunk, which is missing")))?,
-            gltf::buffer::Source::Uri(uri) => load_uri(uri, read_file)
-                .map(Cow::Owned)
-                .map_err(|why| fail(format!("{what} ({}): {why}", short(uri))))?,
+        let content = match buffer.source() {
+            gltf::buffer::Source::Bin => {
+                let bin = blob.take().ok_or_else(|| {
+                    fail(format!("{what} is the GLB binary chunk, which is missing"))
+                })?;
+                contents.push(bin);
+                contents.len() - 1
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                match read_uris.iter().find(|(known, _)| *known == uri) {
+                    Some(&(_, content)) => content,
+                    None => {
+                        let data = load_uri(uri, read_file)
+                            .map_err(|why| fail(format!("{what} ({}): {why}", short(uri))))?;
+                        contents.push(Cow::Owned(data));
+                        read_uris.push((uri, contents.len() - 1));
+                        contents.len() - 1
+                    }
+                }
+            }
         };
-        if data.len() < buffer.length() {
+        let available = contents[content].len();
+        if available < buffer.length() {
             return Err(fail(format!(
-                "{what} declares {} bytes but has only {}",
+                "{what} declares {} bytes but has only {available}",
                 buffer.length(),
-                data.len()
             )));
         }
-        sources.push((data, buffer.length()));
+        sources.push((content, buffer.length()));
     }
     // Each buffer is its declared length: a view beyond it is an error even where the file
     // holds more bytes (a GLB chunk's padding, or a URI's longer file).
-    let buffers: Vec<&[u8]> = sources.iter().map(|(data, len)| &data[..*len]).collect();
+    let buffers: Vec<&[u8]> = sources
+        .iter()
+        .map(|&(content, len)| &contents[content][..len])
+        .collect();
     let scene = document
         .default_scene()
         .or_else(|| document.scenes().next())

@@ -201,6 +201,55 @@ fn mirroring_reverses_the_winding_and_instances_merge() {
 }
 
 #[test]
+fn a_file_named_by_two_buffers_is_read_once() {
+    let reference = parse(&document(
+        r#"[{"mesh": 0}]"#,
+        r#"[{"nodes": [0]}]"#,
+        ONE_PRIMITIVE,
+        &embedded(),
+    ))
+    .unwrap();
+    // The attributes from buffer 0, the indices from buffer 1: the same file, declared with
+    // different lengths (each buffer is checked against its own).
+    let text = document(
+        r#"[{"mesh": 0}]"#,
+        r#"[{"nodes": [0]}]"#,
+        ONE_PRIMITIVE,
+        r#"{"byteLength": 128, "uri": "quad.bin"}, {"byteLength": 140, "uri": "quad.bin"}"#,
+    )
+    .replace(
+        r#"{"buffer": 0, "byteOffset": 128"#,
+        r#"{"buffer": 1, "byteOffset": 128"#,
+    );
+    assert!(text.contains(r#"{"buffer": 1, "byteOffset": 128"#));
+    let mut asked = Vec::new();
+    let external = parse_gltf(text.as_bytes(), &mut |name| {
+        asked.push(name.to_string());
+        Ok(quad_buffer())
+    })
+    .unwrap();
+    assert_eq!(asked, ["quad.bin"]);
+    assert_eq!(external.mesh.positions, reference.mesh.positions);
+    assert_eq!(external.mesh.triangles, reference.mesh.triangles);
+    // Two names, two reads; and a view beyond its own buffer's declared length is still an
+    // error when the file behind it is longer.
+    let two_files = text.replacen(r#""uri": "quad.bin"}"#, r#""uri": "other.bin"}"#, 1);
+    let mut asked = Vec::new();
+    parse_gltf(two_files.as_bytes(), &mut |name| {
+        asked.push(name.to_string());
+        Ok(quad_buffer())
+    })
+    .unwrap();
+    assert_eq!(asked, ["other.bin", "quad.bin"]);
+    let short_view = text.replace(r#""byteLength": 128, "uri""#, r#""byteLength": 100, "uri""#);
+    let err = parse_gltf(short_view.as_bytes(), &mut |_| Ok(quad_buffer())).unwrap_err();
+    assert!(
+        err.to_string().contains("outside its buffer of 100 bytes"),
+        "{err}"
+    );
+}
+
+#[test]
 fn glb_and_external_buffers_read_the_same_bytes() {
     let reference = parse(&document(
         r#"[{"mesh": 0}]"#,
