@@ -122,8 +122,9 @@ pub(crate) const LOCAL_GLOBAL: u8 = 1;
 /// N10: as LM07, plus the kernel-weighted local irradiance sums.
 pub(crate) const EDGE_AWARE: u8 = 2;
 
-/// Room for the deepest tree: each level leaves at most 7 siblings on the stack.
-const STACK_SIZE: usize = (LANES - 1) * MAX_DEPTH + LANES;
+/// Room for the deepest tree: each level leaves at most 7 siblings on the stack, and N10's
+/// deferred pass starts with up to [`DEFERRED`] nodes already on it.
+const STACK_SIZE: usize = (LANES - 1) * MAX_DEPTH + LANES + DEFERRED;
 /// Term buffer: up to 8 pending terms plus one batch being appended.
 const BUFFER: usize = 2 * LANES;
 /// Unlit subtrees near x that N10 can defer (more are visited at once).
