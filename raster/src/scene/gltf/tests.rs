@@ -65,6 +65,27 @@ fn embedded() -> String {
 
 const ONE_PRIMITIVE: &str = r#"[{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]"#;
 
+/// The quad of one node and [`ONE_PRIMITIVE`] with `buffer` (JSON objects) as its buffers.
+fn one_quad(buffer: &str) -> String {
+    document(
+        r#"[{"mesh": 0}]"#,
+        r#"[{"nodes": [0]}]"#,
+        ONE_PRIMITIVE,
+        buffer,
+    )
+}
+
+/// Parses `text`, serving [`quad_buffer`] for every external file; also returns the names
+/// asked for, in order.
+fn parse_serving_quads(text: &str) -> (Result<GltfMesh, GltfError>, Vec<String>) {
+    let mut asked = Vec::new();
+    let parsed = parse_gltf(text.as_bytes(), &mut |name| {
+        asked.push(name.to_string());
+        Ok(quad_buffer())
+    });
+    (parsed, asked)
+}
+
 fn no_files(name: &str) -> Result<Vec<u8>, String> {
     Err(format!("no file {name}"))
 }
@@ -202,19 +223,10 @@ fn mirroring_reverses_the_winding_and_instances_merge() {
 
 #[test]
 fn a_file_named_by_two_buffers_is_read_once() {
-    let reference = parse(&document(
-        r#"[{"mesh": 0}]"#,
-        r#"[{"nodes": [0]}]"#,
-        ONE_PRIMITIVE,
-        &embedded(),
-    ))
-    .unwrap();
+    let reference = parse(&one_quad(&embedded())).unwrap();
     // The attributes from buffer 0, the indices from buffer 1: the same file, declared with
     // different lengths (each buffer is checked against its own).
-    let text = document(
-        r#"[{"mesh": 0}]"#,
-        r#"[{"nodes": [0]}]"#,
-        ONE_PRIMITIVE,
+    let text = one_quad(
         r#"{"byteLength": 128, "uri": "quad.bin"}, {"byteLength": 140, "uri": "quad.bin"}"#,
     )
     .replace(
@@ -222,27 +234,19 @@ fn a_file_named_by_two_buffers_is_read_once() {
         r#"{"buffer": 1, "byteOffset": 128"#,
     );
     assert!(text.contains(r#"{"buffer": 1, "byteOffset": 128"#));
-    let mut asked = Vec::new();
-    let external = parse_gltf(text.as_bytes(), &mut |name| {
-        asked.push(name.to_string());
-        Ok(quad_buffer())
-    })
-    .unwrap();
+    let (external, asked) = parse_serving_quads(&text);
+    let external = external.unwrap();
     assert_eq!(asked, ["quad.bin"]);
     assert_eq!(external.mesh.positions, reference.mesh.positions);
     assert_eq!(external.mesh.triangles, reference.mesh.triangles);
     // Two names, two reads; and a view beyond its own buffer's declared length is still an
     // error when the file behind it is longer.
     let two_files = text.replacen(r#""uri": "quad.bin"}"#, r#""uri": "other.bin"}"#, 1);
-    let mut asked = Vec::new();
-    parse_gltf(two_files.as_bytes(), &mut |name| {
-        asked.push(name.to_string());
-        Ok(quad_buffer())
-    })
-    .unwrap();
+    let (parsed, asked) = parse_serving_quads(&two_files);
+    parsed.unwrap();
     assert_eq!(asked, ["other.bin", "quad.bin"]);
     let short_view = text.replace(r#""byteLength": 128, "uri""#, r#""byteLength": 100, "uri""#);
-    let err = parse_gltf(short_view.as_bytes(), &mut |_| Ok(quad_buffer())).unwrap_err();
+    let err = parse_serving_quads(&short_view).0.unwrap_err();
     assert!(
         err.to_string().contains("outside its buffer of 100 bytes"),
         "{err}"
@@ -251,26 +255,12 @@ fn a_file_named_by_two_buffers_is_read_once() {
 
 #[test]
 fn glb_and_external_buffers_read_the_same_bytes() {
-    let reference = parse(&document(
-        r#"[{"mesh": 0}]"#,
-        r#"[{"nodes": [0]}]"#,
-        ONE_PRIMITIVE,
-        &embedded(),
-    ))
-    .unwrap();
+    let reference = parse(&one_quad(&embedded())).unwrap();
     // External file with a %-escaped name.
-    let text = document(
-        r#"[{"mesh": 0}]"#,
-        r#"[{"nodes": [0]}]"#,
-        ONE_PRIMITIVE,
+    let (external, asked) = parse_serving_quads(&one_quad(
         r#"{"byteLength": 140, "uri": "quad%20data.bin"}"#,
-    );
-    let mut asked = Vec::new();
-    let external = parse_gltf(text.as_bytes(), &mut |name| {
-        asked.push(name.to_string());
-        Ok(quad_buffer())
-    })
-    .unwrap();
+    ));
+    let external = external.unwrap();
     assert_eq!(asked, ["quad data.bin"]);
     assert_eq!(external.mesh.positions, reference.mesh.positions);
     assert_eq!(external.mesh.triangles, reference.mesh.triangles);
