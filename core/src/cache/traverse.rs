@@ -197,46 +197,82 @@ const fn compact_table() -> [[u8; LANES]; 256] {
 static COMPACT: [[u8; LANES]; 256] = compact_table();
 
 /// How [`Buffer::append`] moves the kept lanes of a batch to the front.
+///
+/// Index loops rather than iterator adapters or closures here and in the rest of the
+/// traversal: the AVX2 path inlines all of it into one function, and there the compiler left
+/// such helpers as out-of-line calls, compiled without AVX2.
 pub(crate) trait Compaction: Copy {
-    /// True: [`Compaction::permute`] moves a whole column in registers, and every append
-    /// writes eight entries per column. False: the lanes are moved one by one through memory
-    /// (the baseline lanes: SSE2 has no variable permutation across eight lanes).
-    const IN_REGISTERS: bool;
-    /// Lane i of the result is lane `order`'s byte i (little-endian, each < 8) of `values`.
-    fn permute(self, values: [f32; LANES], order: u64) -> [f32; LANES];
+    /// Writes each of `values` into its column from `len` on, lane `order[i]` at `len + i`;
+    /// the first `n` (the kept lanes) must land, the rest may be anything.
+    fn compact<L: Lanes, const C: usize>(
+        self,
+        columns: &mut [[f32; BUFFER]; C],
+        len: usize,
+        values: [L; C],
+        order: &[u8; LANES],
+        n: usize,
+    );
 }
 
-/// Lane by lane, through memory: any instruction set.
+/// Lane by lane, through memory: any instruction set (SSE2 has no variable permutation
+/// across eight lanes). Four entries per column when at most four lanes are kept.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LaneByLane;
 
 impl Compaction for LaneByLane {
-    const IN_REGISTERS: bool = false;
     #[inline(always)]
-    fn permute(self, values: [f32; LANES], order: u64) -> [f32; LANES] {
-        let order = order.to_le_bytes();
-        let mut moved = [0.0; LANES];
-        for i in 0..LANES {
-            moved[i] = values[(order[i] & 7) as usize];
+    fn compact<L: Lanes, const C: usize>(
+        self,
+        columns: &mut [[f32; BUFFER]; C],
+        len: usize,
+        values: [L; C],
+        order: &[u8; LANES],
+        n: usize,
+    ) {
+        if n <= LANES / 2 {
+            for c in 0..C {
+                let v = values[c].to_array();
+                let dst = &mut columns[c][len..len + LANES / 2];
+                for i in 0..LANES / 2 {
+                    dst[i] = v[(order[i] & 7) as usize];
+                }
+            }
+        } else {
+            for c in 0..C {
+                let v = values[c].to_array();
+                let dst = &mut columns[c][len..len + LANES];
+                for i in 0..LANES {
+                    dst[i] = v[(order[i] & 7) as usize];
+                }
+            }
         }
-        moved
     }
 }
 
-/// A permutation in registers (AVX2's `vpermps`, [`crate::lanes::permute_avx2`]), given as a
-/// closure: made inside the one `#[target_feature(enable = "avx2")]` function, the closure is
-/// compiled for AVX2 too, so the intrinsic is safe to call there, and the generic traversal
-/// only calls the closure.
+/// A permutation in registers (AVX2's `vpermps`, [`crate::lanes::permute_avx2`]) of a whole
+/// column, eight entries written per column. Given as a closure: made inside the one
+/// `#[target_feature(enable = "avx2")]` function, the closure is compiled for AVX2 too, so the
+/// intrinsic is safe to call there, and the generic traversal only calls the closure.
 #[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct InRegisters<F>(pub F);
 
 #[cfg(all(feature = "simd", any(target_arch = "x86", target_arch = "x86_64")))]
 impl<F: Fn([f32; LANES], u64) -> [f32; LANES] + Copy> Compaction for InRegisters<F> {
-    const IN_REGISTERS: bool = true;
     #[inline(always)]
-    fn permute(self, values: [f32; LANES], order: u64) -> [f32; LANES] {
-        (self.0)(values, order)
+    fn compact<L: Lanes, const C: usize>(
+        self,
+        columns: &mut [[f32; BUFFER]; C],
+        len: usize,
+        values: [L; C],
+        order: &[u8; LANES],
+        _n: usize,
+    ) {
+        let order = u64::from_le_bytes(*order);
+        for c in 0..C {
+            let moved = (self.0)(values[c].to_array(), order);
+            columns[c][len..len + LANES].copy_from_slice(&moved);
+        }
     }
 }
 
@@ -265,32 +301,7 @@ impl<const C: usize> Buffer<C> {
         let order = &COMPACT[(keep.0 & 0xff) as usize];
         let len = self.len.min(LANES);
         let n = keep.0.count_ones() as usize;
-        // Index loops rather than iterator adapters or closures here and in the rest of the
-        // traversal: the AVX2 path inlines all of it into one function, and there the compiler
-        // left such helpers as out-of-line calls, compiled without AVX2.
-        if K::IN_REGISTERS {
-            let order = u64::from_le_bytes(*order);
-            for c in 0..C {
-                let moved = by.permute(values[c].to_array(), order);
-                self.columns[c][len..len + LANES].copy_from_slice(&moved);
-            }
-        } else if n <= LANES / 2 {
-            for c in 0..C {
-                let v = values[c].to_array();
-                let dst = &mut self.columns[c][len..len + LANES / 2];
-                for i in 0..LANES / 2 {
-                    dst[i] = v[(order[i] & 7) as usize];
-                }
-            }
-        } else {
-            for c in 0..C {
-                let v = values[c].to_array();
-                let dst = &mut self.columns[c][len..len + LANES];
-                for i in 0..LANES {
-                    dst[i] = v[(order[i] & 7) as usize];
-                }
-            }
-        }
+        by.compact(&mut self.columns, len, values, order, n);
         self.len = len + n;
         self.len >= LANES
     }
