@@ -1,10 +1,10 @@
 //! BVH construction: top-down binned SAH (Wald 2007, "On fast Construction of SAH-based
 //! Bounding Volume Hierarchies", IEEE Symposium on Interactive Ray Tracing).
 //!
-//! Every node bins its triangles' centroids into [`BINS`] equal slabs along each axis, sweeps
-//! the bins to price every split plane with the surface area heuristic, and either splits at the
-//! cheapest plane or becomes a leaf when that is cheaper (and it holds at most [`MAX_LEAF`]
-//! triangles). Each level is O(N), so the build is O(N log N) for the usual balanced splits; to
+//! Every node bins its triangles' centroids into [`BINS`] equal slabs along each axis (a node
+//! of more than [`BINNED`] triangles, a regular sample of them), sweeps the bins to price every
+//! split plane with the surface area heuristic, and either splits at the cheapest plane or
+//! becomes a leaf when that is cheaper (and it holds at most [`MAX_LEAF`] triangles). Each level is O(N), so the build is O(N log N) for the usual balanced splits; to
 //! bound the depth (and so the fixed traversal stack) for any input, nodes deeper than
 //! [`MEDIAN_DEPTH`] switch to object-median splits, which halve the count, so no path is longer
 //! than `MEDIAN_DEPTH + 31` for fewer than 2³¹ triangles.
@@ -24,6 +24,11 @@ use super::node::{BvhNode, WideNode};
 
 /// Centroid bins per axis. Wald 2007 found 16–32 bins within a few percent of a full sweep.
 pub(super) const BINS: usize = 16;
+/// A node of more triangles than this prices its planes from a sample of about this many,
+/// every k-th of its triangles (their boxes and the partition stay exact). On a 7.8 M-triangle
+/// mesh the split search was a fifth of the render's CPU, most of it binning the top levels'
+/// millions of triangles into 16 slabs whose costs a few thousand estimate as well.
+pub(super) const BINNED: usize = 1 << 12;
 /// Most triangles in one leaf.
 pub(super) const MAX_LEAF: u32 = 8;
 const _: () = assert!(
@@ -61,7 +66,7 @@ pub(super) struct Built {
 /// Subtrees of at least this many triangles are built on two threads (`rayon::join`), their
 /// halves apart; smaller ones in one go. On a 2 M-triangle mesh, 2¹⁴ leaves a few hundred
 /// pieces, enough for the threads to share the work and few enough that splicing them is cheap.
-const PARALLEL_MIN: usize = 1 << 14;
+pub(super) const PARALLEL_MIN: usize = 1 << 14;
 
 /// A box as the builder keeps it: [`Aabb`]'s arithmetic on 16-byte lanes. `Aabb`'s
 /// `Vec3::min`/`max` are NaN-aware and lane by lane; here each is one `minps`/`maxps`, which
@@ -148,17 +153,16 @@ enum Piece {
     },
 }
 
-/// Builds the tree over `triangles` (only the first [`MAX_TRIANGLES`] are looked at).
-pub(super) fn build(triangles: &[[Vec3; 3]]) -> Result<Built, OutOfMemory> {
-    build_splitting_from(triangles, PARALLEL_MIN)
-}
-
-/// [`build`], building subtrees of at least `parallel_min` triangles on two threads. The nodes
-/// are the same for every `parallel_min` (the one-threaded build's), so that tests can compare
-/// a build split into many pieces with one that is not split at all.
-pub(super) fn build_splitting_from(
+/// Builds the tree over `triangles` (only the first [`MAX_TRIANGLES`] are looked at), building
+/// subtrees of at least `parallel_min` triangles on two threads and pricing the planes of a
+/// node of more than `binned` triangles from about `binned` of them. The nodes are the same
+/// for every `parallel_min` (the one-threaded build's), so that tests can compare a build split
+/// into many pieces with one that is not split at all. The renderer passes [`PARALLEL_MIN`]
+/// and [`BINNED`]; tests lower `binned` so that small inputs take the sampled path too.
+pub(super) fn build_with(
     triangles: &[[Vec3; 3]],
     parallel_min: usize,
+    binned: usize,
 ) -> Result<Built, OutOfMemory> {
     let triangles = &triangles[..triangles.len().min(MAX_TRIANGLES)];
     let mut boxes = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
@@ -179,7 +183,10 @@ pub(super) fn build_splitting_from(
             skipped,
         });
     }
-    let builder = Builder { boxes: &boxes };
+    let builder = Builder {
+        boxes: &boxes,
+        binned: binned.max(1),
+    };
     let nodes = match builder.piece(&mut order, 0, 0, parallel_min.max(2))? {
         Piece::Whole(nodes) => nodes,
         split => {
@@ -235,6 +242,8 @@ fn shifted(mut node: BvhNode, shift: u32) -> BvhNode {
 /// no gain on 100 k or 5 M triangles.)
 struct Builder<'a> {
     boxes: &'a [Bounds],
+    /// About how many triangles price a node's planes (see [`BINNED`]).
+    binned: usize,
 }
 
 /// A candidate split: bin plane `bin` (left side = bins `0..=bin`) on `axis`.
@@ -416,14 +425,17 @@ impl Builder<'_> {
     /// On each axis along which the centroids spread, the cheapest of the `BINS − 1` planes that
     /// leave both sides non-empty, priced as `area(L)·|L| + area(R)·|R|` (the parent's area and
     /// the traversal cost are added by the caller). The three axes are binned in one pass over
-    /// `items`, each triangle's box read once (a pass per axis read them three times).
+    /// `items`, each triangle's box read once (a pass per axis read them three times); above
+    /// [`Builder::binned`] triangles, over every k-th of them. Both sides of the plane chosen
+    /// hold some of those, so neither side of the partition is empty.
     fn best_planes(&self, items: &[u32], cb: &Bounds) -> [Option<Split>; 3] {
         let extent = cb.max - cb.min;
         let spread = [0, 1, 2].map(|a| extent[a] > 0.0);
         let scale = [0, 1, 2].map(|a| BINS as f32 / extent[a]);
         let mut counts = [[0u32; BINS]; 3];
         let mut boxes = [[Bounds::EMPTY; BINS]; 3];
-        for &i in items {
+        let stride = (items.len() / self.binned).max(1);
+        for &i in items.iter().step_by(stride) {
             let b = self.boxes[i as usize];
             let c = b.center();
             for a in 0..3 {

@@ -134,11 +134,20 @@ impl Bvh {
 
     /// [`Bvh::build`], or [`OutOfMemory`] if the allocator refuses one of its buffers.
     pub fn try_build(triangles: &[[Vec3; 3]]) -> Result<Bvh, OutOfMemory> {
+        Self::try_build_binning(triangles, build::BINNED)
+    }
+
+    /// [`Bvh::try_build`], a node's planes priced from about `binned` of its triangles (tests
+    /// set it low, so that small inputs take the sampled path too).
+    pub(super) fn try_build_binning(
+        triangles: &[[Vec3; 3]],
+        binned: usize,
+    ) -> Result<Bvh, OutOfMemory> {
         let build::Built {
             nodes,
             order,
             skipped,
-        } = build::build(triangles)?;
+        } = build::build_with(triangles, build::PARALLEL_MIN, binned)?;
         // The binary tree is collapsed and freed before the triangles are copied, so that the
         // two are never held at once (this is where the preparation's memory peaks).
         let wide = build::collapse(&nodes)?;

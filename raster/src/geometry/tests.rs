@@ -86,7 +86,12 @@ fn queries_match_brute_force_on_random_scenes() {
     let mut rng = Pcg32::new(2024, 0);
     for (scene, n) in [1usize, 2, 7, 50, 400, 3000].into_iter().enumerate() {
         let tris = random_scene(&mut rng, n);
-        let bvh = Bvh::build(&tris);
+        // Every other scene's planes priced from samples of 40 triangles.
+        let bvh = if scene % 2 == 0 {
+            Bvh::build(&tris)
+        } else {
+            Bvh::try_build_binning(&tris, 40).unwrap()
+        };
         check(&bvh, &tris);
         let mut hits = 0;
         for _ in 0..2_000 {
@@ -351,14 +356,17 @@ fn build_is_deterministic() {
 fn every_node_bounds_exactly_its_triangles() {
     // Each node's bounds are exactly the union of its triangles' boxes (the SAH prices splits
     // by these areas, and a loose box costs rays a visit), checked node by node against a walk
-    // of its subtree.
+    // of its subtree; with every triangle binned and with planes priced from samples.
     let mut rng = Pcg32::new(3, 9);
-    for tris in [
+    for (tris, binned) in [
         random_scene(&mut rng, 3000),
         icosphere(4, Vec3::ZERO, 1.0),
         chain(300, 1.1),
-    ] {
-        let built = build::build_splitting_from(&tris, 64).unwrap();
+    ]
+    .into_iter()
+    .flat_map(|tris| [(tris.clone(), build::BINNED), (tris, 40)])
+    {
+        let built = build::build_with(&tris, 64, binned).unwrap();
         // Each node's triangles, by walking its subtree.
         fn union(nodes: &[BvhNode], order: &[u32], tris: &[[Vec3; 3]], n: usize) -> Aabb {
             let node = &nodes[n];
@@ -383,18 +391,19 @@ fn a_build_split_over_threads_is_the_one_threaded_build() {
     // Pieces built apart and spliced must give the one-threaded build's node array exactly,
     // however finely the tree is cut into pieces. The inputs: a random soup (with exact
     // copies), a closed sphere, and a chain that SAH splits one triangle at a time, deep enough
-    // to reach the object-median splits.
+    // to reach the object-median splits; with planes priced from every triangle and from
+    // samples.
     let mut rng = Pcg32::new(15, 4);
     let inputs = [
         random_scene(&mut rng, 3000),
         icosphere(4, Vec3::ZERO, 1.0),
         chain(300, 1.1),
     ];
-    for tris in &inputs {
-        let one = build::build_splitting_from(tris, usize::MAX).unwrap();
+    for (tris, binned) in inputs.iter().flat_map(|t| [(t, build::BINNED), (t, 40)]) {
+        let one = build::build_with(tris, usize::MAX, binned).unwrap();
         let mut pieces_seen = 0;
         for parallel_min in [2, 9, 64, 1000] {
-            let split = build::build_splitting_from(tris, parallel_min).unwrap();
+            let split = build::build_with(tris, parallel_min, binned).unwrap();
             assert_eq!(
                 split.nodes,
                 one.nodes,
@@ -563,7 +572,10 @@ fn validate_catches_broken_wide_trees() {
     let tris = random_scene(&mut rng, 500);
     let good = Bvh::build(&tris);
     good.validate().unwrap();
-    let binary = build::build(&tris).unwrap().nodes.len();
+    let binary = build::build_with(&tris, build::PARALLEL_MIN, build::BINNED)
+        .unwrap()
+        .nodes
+        .len();
     assert!(good.wide.len() > 10 && good.wide.len() * 2 < binary);
     type Breakage = (&'static str, fn(&mut Bvh));
     let breakages: [Breakage; 9] = [
@@ -628,4 +640,56 @@ fn leaf_lane(bvh: &Bvh) -> (usize, usize) {
             (0..n.len()).find(|&l| n.count[l] > 0).map(|l| (i, l))
         })
         .unwrap()
+}
+
+/// The surface area heuristic's cost of a binary tree over its root's area: the expected
+/// traversal steps plus triangle tests of a ray through the root (the cost the builder
+/// minimises node by node).
+fn sah_cost(nodes: &[BvhNode]) -> f64 {
+    let area = |n: &BvhNode| n.bounds().half_area() as f64;
+    let total: f64 = nodes
+        .iter()
+        .map(|n| {
+            if n.is_leaf() {
+                area(n) * n.count as f64
+            } else {
+                area(n)
+            }
+        })
+        .sum();
+    total / area(&nodes[0])
+}
+
+#[test]
+fn planes_priced_from_samples_build_a_tree_about_as_good() {
+    // Pricing a large node's planes from every k-th triangle instead of all of them must not
+    // make rays much dearer: the SAH cost of the tree against the one that bins every
+    // triangle, on a soup, a sphere and a field of slivers, with samples down to 1 in 100.
+    let mut rng = Pcg32::new(8, 21);
+    let slivers: Vec<[Vec3; 3]> = (0..6000)
+        .map(|i| {
+            let p = random_point(&mut rng, -10.0, 10.0);
+            let d = Vec3::new(0.01, 2.0 * (i % 7) as f32 + 0.1, 0.01);
+            [p, p + d, p + Vec3::new(0.0, 0.0, 0.05)]
+        })
+        .collect();
+    for (name, tris) in [
+        ("soup", random_scene(&mut rng, 6000)),
+        ("sphere", icosphere(5, Vec3::ZERO, 1.0)),
+        ("slivers", slivers),
+    ] {
+        let every = sah_cost(
+            &build::build_with(&tris, usize::MAX, usize::MAX)
+                .unwrap()
+                .nodes,
+        );
+        for binned in [1000, 200] {
+            let sampled = sah_cost(&build::build_with(&tris, usize::MAX, binned).unwrap().nodes);
+            let ratio = sampled / every;
+            assert!(
+                ratio < 1.03,
+                "{name}, {binned} binned: SAH cost {sampled:.2} against {every:.2}"
+            );
+        }
+    }
 }
