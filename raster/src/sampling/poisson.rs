@@ -83,7 +83,7 @@ use super::grid::{ChunkCounts, Layout, Neighbourhood, Tiles, count_tiles};
 use super::maxtree::MaxTree;
 use super::rng::{Pcg32, splitmix64};
 use super::strata::Strata;
-use super::surface::{AreaDistribution, SampleTarget, SurfacePoint, hex_spacing};
+use super::surface::{AreaDistribution, SampleTarget, SurfacePoint, hex_spacing, vertex_bounds};
 
 /// Candidates per output sample (Yuksel 2015 §5 recommends 5; with stratified candidates 4
 /// gives the same quality: see the module documentation).
@@ -156,10 +156,7 @@ pub fn poisson_samples_with_progress(
     // 2. Tiles: counted, then filled.
     let d_max = hex_spacing(dist.total(), n as u32);
     let d_min = (d_max as f64 * (1.0 - weight_limit_power()) * BETA) as f32;
-    let origin = triangles
-        .iter()
-        .flatten()
-        .fold(Vec3::INFINITY, |lo, &v| lo.min(v));
+    let (origin, _) = vertex_bounds(triangles);
     // Cells slightly larger than d_max, so rounding in the cell coordinates cannot separate a
     // pair closer than d_max.
     let layout = Layout::new(origin, d_max * 1.0001);

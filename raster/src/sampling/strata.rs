@@ -30,9 +30,10 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use lucent_core::internals::Grid;
+use rayon::prelude::*;
 
 use super::rng::Pcg32;
-use super::surface::{SurfacePoint, triangle_area};
+use super::surface::{SurfacePoint, triangle_area, vertex_bounds};
 
 /// Candidates one piece holds on average, at most (pieces are split until they hold fewer).
 const PIECE_CANDIDATES: f64 = 4.0;
@@ -90,39 +91,41 @@ impl Strata {
     /// area `total`.
     pub(super) fn new(triangles: &[[Vec3; 3]], total: f64, m: usize) -> Strata {
         let max_area = PIECE_CANDIDATES * total / m.max(1) as f64;
-        // Morton order of the centroids; ties (identical codes) keep the input order.
-        let (lo, hi) = triangles
-            .iter()
-            .flatten()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &c| {
-                (lo.min(c), hi.max(c))
-            });
+        // Morton order of the centroids; ties (identical codes) keep the input order. Every
+        // pass but the running sum is parallel and gives the serial result: min and max are
+        // exact, and the sort's keys are distinct (the index is part of them).
+        let (lo, hi) = vertex_bounds(triangles);
         let grid = Grid::new(lo, hi);
         let mut order: Vec<(u64, u32)> = triangles
-            .iter()
+            .par_iter()
             .enumerate()
             .filter(|(_, t)| triangle_area(t) > 0.0)
             .map(|(i, t)| (grid.code((t[0] + t[1] + t[2]) / 3.0), i as u32))
             .collect();
-        order.sort_unstable();
-        let mut strata = Strata {
-            triangle: Vec::with_capacity(order.len()),
-            levels: Vec::with_capacity(order.len()),
-            cumulative: Vec::with_capacity(order.len()),
-        };
+        order.par_sort_unstable();
+        let triangle: Vec<u32> = order.into_iter().map(|(_, i)| i).collect();
+        let (mut cumulative, levels): (Vec<f64>, Vec<u8>) = triangle
+            .par_iter()
+            .map(|&i| {
+                let a = triangle_area(&triangles[i as usize]);
+                let mut levels = 0;
+                while levels < MAX_LEVELS && a / 4f64.powi(levels as i32) > max_area {
+                    levels += 1;
+                }
+                (a, levels as u8)
+            })
+            .unzip();
+        // The running sum in order, area by area (its rounding is part of the samples).
         let mut sum = 0.0;
-        for &(_, i) in &order {
-            let a = triangle_area(&triangles[i as usize]);
-            let mut levels = 0;
-            while levels < MAX_LEVELS && a / 4f64.powi(levels as i32) > max_area {
-                levels += 1;
-            }
-            sum += a;
-            strata.triangle.push(i);
-            strata.levels.push(levels as u8);
-            strata.cumulative.push(sum);
+        for c in &mut cumulative {
+            sum += *c;
+            *c = sum;
         }
-        strata
+        Strata {
+            triangle,
+            levels,
+            cumulative,
+        }
     }
 
     /// Candidates `first .. first + out.len()` of `m`, in order, drawing from `rng`: candidate

@@ -93,6 +93,25 @@ fn same_seed_gives_identical_bits_for_any_thread_count() {
     assert!(same < 30, "seeds 7 and 8 share {same} of 3000 samples");
 }
 
+#[test]
+fn many_triangles_give_the_same_bits_for_any_thread_count() {
+    // 81 920 sphere triangles and the floor: several chunks for the parallel passes over the
+    // triangles (bounds, Morton codes, the sort, the areas), which must give the serial order
+    // and running sums whatever the threads.
+    let tris = sphere_over_floor(6);
+    assert!(tris.len() > 5 * (1 << 14));
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| poisson_samples(&tris, SampleTarget::Count(600), 5).unwrap())
+    };
+    let one = fingerprint(&run(1));
+    assert_eq!(one, fingerprint(&run(2)));
+    assert_eq!(one, fingerprint(&run(3)));
+}
+
 /// FNV-1a over the bits of every sample.
 fn fingerprint(s: &[SurfacePoint]) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
