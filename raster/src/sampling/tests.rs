@@ -67,16 +67,24 @@ fn places_exactly_the_requested_count() {
     assert!((hex_spacing(area, want as u32) - spacing).abs() < 1e-4);
 }
 
+/// `count` samples with `seed`, placed on a pool of `threads` threads.
+fn samples_on_threads(
+    tris: &[[Vec3; 3]],
+    count: u32,
+    seed: u64,
+    threads: usize,
+) -> Vec<SurfacePoint> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| poisson_samples(tris, SampleTarget::Count(count), seed).unwrap())
+}
+
 #[test]
 fn same_seed_gives_identical_bits_for_any_thread_count() {
     let tris = sphere_and_plane();
-    let run = |threads: usize, seed: u64| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| poisson_samples(&tris, SampleTarget::Count(3000), seed).unwrap())
-    };
+    let run = |threads: usize, seed: u64| samples_on_threads(&tris, 3000, seed, threads);
     let bits = |s: &[SurfacePoint]| -> Vec<(u32, [u32; 5])> {
         s.iter()
             .map(|p| {
@@ -100,13 +108,7 @@ fn many_triangles_give_the_same_bits_for_any_thread_count() {
     // and running sums whatever the threads.
     let tris = sphere_over_floor(6);
     assert!(tris.len() > 5 * (1 << 14));
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| poisson_samples(&tris, SampleTarget::Count(600), 5).unwrap())
-    };
+    let run = |threads: usize| samples_on_threads(&tris, 600, 5, threads);
     let one = fingerprint(&run(1));
     assert_eq!(one, fingerprint(&run(2)));
     assert_eq!(one, fingerprint(&run(3)));
@@ -464,12 +466,6 @@ fn progress_rises_to_one() {
 #[test]
 fn eight_threads_give_the_same_bits() {
     let tris = sphere_and_plane();
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| poisson_samples(&tris, SampleTarget::Count(20_000), 3).unwrap())
-    };
+    let run = |threads: usize| samples_on_threads(&tris, 20_000, 3, threads);
     assert_eq!(fingerprint(&run(1)), fingerprint(&run(8)));
 }
