@@ -92,8 +92,9 @@ impl Strata {
     pub(super) fn new(triangles: &[[Vec3; 3]], total: f64, m: usize) -> Strata {
         let max_area = PIECE_CANDIDATES * total / m.max(1) as f64;
         // Morton order of the centroids; ties (identical codes) keep the input order. Every
-        // pass but the running sum is parallel and gives the serial result: min and max are
-        // exact, and the sort's keys are distinct (the index is part of them).
+        // pass but the running sum is parallel and gives the serial result: the bounds are
+        // exact (see `vertex_bounds`), and the sort's keys are distinct (the index is part of
+        // them).
         let (lo, hi) = vertex_bounds(triangles);
         let grid = Grid::new(lo, hi);
         let mut order: Vec<(u64, u32)> = triangles

@@ -93,8 +93,10 @@ pub fn triangle_area(t: &[Vec3; 3]) -> f64 {
     0.5 * (b - a).cross(c - a).length()
 }
 
-/// The smallest and largest coordinates of the triangles' vertices, per axis, in parallel (min
-/// and max are exact, so the result is the serial one).
+/// The smallest and largest coordinates of the triangles' vertices, per axis, in parallel: min
+/// and max are exact, so the values are the serial ones for any thread count (a zero may come
+/// out as −0 or +0, which the grids built from them, `p − origin` clamped at 0, cannot tell
+/// apart).
 pub(super) fn vertex_bounds(triangles: &[[Vec3; 3]]) -> (Vec3, Vec3) {
     let empty = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     triangles
