@@ -2,6 +2,7 @@
 //! and the conservative slab test used during traversal.
 
 use glam::{Vec3, Vec3A, Vec4};
+use rayon::prelude::*;
 
 use super::node::WideNode;
 
@@ -80,6 +81,23 @@ impl Aabb {
     pub fn is_finite(&self) -> bool {
         self.min.is_finite() && self.max.is_finite()
     }
+}
+
+/// The smallest and largest coordinates of the triangles' vertices, per axis, in parallel: min
+/// and max are exact, so the values are the serial ones for any thread count (a zero may come
+/// out as −0 or +0, which the grids built from them, `p − origin` clamped at 0, cannot tell
+/// apart; the renderer's scale, a length, neither).
+pub(crate) fn vertex_bounds(triangles: &[[Vec3; 3]]) -> (Vec3, Vec3) {
+    let empty = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    triangles
+        .par_chunks(1 << 14)
+        .map(|chunk| {
+            chunk
+                .iter()
+                .flatten()
+                .fold(empty, |(lo, hi), &v| (lo.min(v), hi.max(v)))
+        })
+        .reduce(|| empty, |(a, b), (c, d)| (a.min(c), b.max(d)))
 }
 
 /// `1 + 2γ₃` with `γₙ = n·u / (1 − n·u)` and `u = 2⁻²⁴`: the factor by which the far slab

@@ -29,6 +29,7 @@ mod ray;
 pub mod shapes;
 
 pub use aabb::Aabb;
+pub(crate) use aabb::vertex_bounds;
 pub use bvh::{Bvh, InvariantError, ShadowHint};
 pub use node::WideNode;
 pub use ray::{Hit, OFFSET_RELATIVE, Ray, offset_origin};

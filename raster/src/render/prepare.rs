@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::RenderError;
 use super::convexity::cannot_shadow_itself;
-use crate::geometry::Bvh;
+use crate::geometry::{Bvh, vertex_bounds};
 use crate::material::Shader;
 use crate::memory;
 use crate::scene::{Object, Scene};
@@ -72,12 +72,7 @@ impl<'s> Prepared<'s> {
             }
         }
         first_triangle.push(triangles.len() as u32);
-        let (lo, hi) = triangles
-            .iter()
-            .flatten()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            });
+        let (lo, hi) = vertex_bounds(&triangles);
         let scale = if triangles.is_empty() {
             1.0
         } else {

@@ -83,7 +83,8 @@ use super::grid::{ChunkCounts, Layout, Neighbourhood, Tiles, count_tiles};
 use super::maxtree::MaxTree;
 use super::rng::{Pcg32, splitmix64};
 use super::strata::Strata;
-use super::surface::{AreaDistribution, SampleTarget, SurfacePoint, hex_spacing, vertex_bounds};
+use super::surface::{AreaDistribution, SampleTarget, SurfacePoint, hex_spacing};
+use crate::geometry::vertex_bounds;
 
 /// Candidates per output sample (Yuksel 2015 §5 recommends 5; with stratified candidates 4
 /// gives the same quality: see the module documentation).

@@ -33,7 +33,8 @@ use lucent_core::internals::Grid;
 use rayon::prelude::*;
 
 use super::rng::Pcg32;
-use super::surface::{SurfacePoint, triangle_area, vertex_bounds};
+use super::surface::{SurfacePoint, triangle_area};
+use crate::geometry::vertex_bounds;
 
 /// Candidates one piece holds on average, at most (pieces are split until they hold fewer).
 const PIECE_CANDIDATES: f64 = 4.0;

@@ -2,7 +2,6 @@
 //! candidates that sample elimination thins out.
 
 use glam::{Vec2, Vec3};
-use rayon::prelude::*;
 
 use super::error::{MAX_SAMPLES, SamplingError};
 use crate::scene::SampleDensity;
@@ -91,23 +90,6 @@ pub fn hex_spacing(total_area: f64, count: u32) -> f32 {
 pub fn triangle_area(t: &[Vec3; 3]) -> f64 {
     let (a, b, c) = (t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3());
     0.5 * (b - a).cross(c - a).length()
-}
-
-/// The smallest and largest coordinates of the triangles' vertices, per axis, in parallel: min
-/// and max are exact, so the values are the serial ones for any thread count (a zero may come
-/// out as −0 or +0, which the grids built from them, `p − origin` clamped at 0, cannot tell
-/// apart).
-pub(super) fn vertex_bounds(triangles: &[[Vec3; 3]]) -> (Vec3, Vec3) {
-    let empty = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    triangles
-        .par_chunks(1 << 14)
-        .map(|chunk| {
-            chunk
-                .iter()
-                .flatten()
-                .fold(empty, |(lo, hi), &v| (lo.min(v), hi.max(v)))
-        })
-        .reduce(|| empty, |(a, b), (c, d)| (a.min(c), b.max(d)))
 }
 
 /// Total area of the triangles, summed in `f64` in input order (the mean area per sample is
