@@ -230,21 +230,26 @@ impl Compaction for LaneByLane {
         n: usize,
     ) {
         if n <= LANES / 2 {
-            for c in 0..C {
-                let v = values[c].to_array();
-                let dst = &mut columns[c][len..len + LANES / 2];
-                for i in 0..LANES / 2 {
-                    dst[i] = v[(order[i] & 7) as usize];
-                }
-            }
+            write_in_order::<L, C, { LANES / 2 }>(columns, len, values, order);
         } else {
-            for c in 0..C {
-                let v = values[c].to_array();
-                let dst = &mut columns[c][len..len + LANES];
-                for i in 0..LANES {
-                    dst[i] = v[(order[i] & 7) as usize];
-                }
-            }
+            write_in_order::<L, C, LANES>(columns, len, values, order);
+        }
+    }
+}
+
+/// Writes the first `W` lanes of `order` from each of `values` into its column from `len` on.
+#[inline(always)]
+fn write_in_order<L: Lanes, const C: usize, const W: usize>(
+    columns: &mut [[f32; BUFFER]; C],
+    len: usize,
+    values: [L; C],
+    order: &[u8; LANES],
+) {
+    for c in 0..C {
+        let v = values[c].to_array();
+        let dst = &mut columns[c][len..len + W];
+        for i in 0..W {
+            dst[i] = v[(order[i] & 7) as usize];
         }
     }
 }
