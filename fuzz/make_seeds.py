@@ -591,6 +591,57 @@ def texture_seeds():
     write(t, "unrecognised-text", bytes([DETECT_PNG]) + b"not an image")
 
 
+# ----------------------------------------------------------------------- exr_tile_read_never_panics
+def exr_scanlines(channels, data_window, display_window, extra=b""):
+    """An uncompressed scan-line OpenEXR file. `channels`: (name, values row-major) pairs, f32;
+    windows as (x0, y0, x1, y1) inclusive; `extra`: more header attributes, already encoded."""
+    def attribute(name, kind, value):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + u32(len(value)) + value
+
+    def box(b):
+        return b"".join(struct.pack("<i", v) for v in b)
+
+    channels = sorted(channels)
+    chlist = b"".join(name.encode() + b"\0" + u32(2) + bytes([0, 0, 0, 0]) + u32(1) + u32(1)
+                      for name, _ in channels) + b"\0"
+    header = (attribute("channels", "chlist", chlist)
+              + attribute("compression", "compression", bytes([0]))
+              + attribute("dataWindow", "box2i", box(data_window))
+              + attribute("displayWindow", "box2i", box(display_window))
+              + attribute("lineOrder", "lineOrder", bytes([0]))
+              + attribute("pixelAspectRatio", "float", f32(1.0))
+              + attribute("screenWindowCenter", "v2f", f32(0.0) + f32(0.0))
+              + attribute("screenWindowWidth", "float", f32(1.0))
+              + extra + b"\0")
+    x0, y0, x1, y1 = data_window
+    width, height = x1 - x0 + 1, y1 - y0 + 1
+    start = 8 + len(header) + 8 * height
+    chunks = b""
+    offsets = b""
+    for row in range(height):
+        pixels = b"".join(f32(values[row * width + x]) for _, values in channels for x in range(width))
+        offsets += struct.pack("<Q", start + len(chunks))
+        chunks += struct.pack("<i", y0 + row) + u32(len(pixels)) + pixels
+    return b"\x76\x2f\x31\x01" + u32(2) + header + offsets + chunks
+
+
+def exr_tile_seeds():
+    t = "exr_tile_read_never_panics"
+    n = 2 * 3
+    ramp = [i / n for i in range(n)]
+    exposure = b"lucentExposure\0float\0" + u32(4) + f32(-1.5)
+    tile = [("R", ramp), ("G", [0.5] * n), ("B", [1.0 - v for v in ramp]), ("A", [1.0] * n),
+            ("depth.Z", [2.0] * n), ("exitance.R", ramp), ("exitance.G", ramp), ("exitance.B", ramp)]
+    # A 2 x 3 tile at (3, 1) of an 8 x 6 image, with alpha, a scalar and an RGB layer.
+    write(t, "tile-layers-exposure", exr_scanlines(tile, (3, 1, 4, 3), (0, 0, 7, 5), exposure))
+    # A whole image (data window = display window), beauty only.
+    write(t, "whole-beauty", exr_scanlines(tile[:3], (0, 0, 1, 2), (0, 0, 1, 2)))
+    # The data window reaching past the display window: not a tile.
+    write(t, "data-outside-display", exr_scanlines(tile[:3], (3, 1, 4, 3), (0, 0, 3, 3)))
+    # A layer missing a channel, and no beauty.
+    write(t, "layer-without-beauty", exr_scanlines(tile[4:7], (0, 0, 1, 2), (0, 0, 1, 2)))
+
+
 def crop_seed(scene=0, method=3, size=(40, 30), aa=1, step=1, tolerance=0.25, vfov=30.0,
               crop=(0, 0, 40, 30), threads_swapped=False):
     """One crops_match_the_whole_render input (layout in tests/src/fuzz_props/crops.rs)."""
@@ -642,4 +693,5 @@ if __name__ == "__main__":
     shadow_seeds()
     convexity_seeds()
     texture_seeds()
+    exr_tile_seeds()
     crop_seeds()

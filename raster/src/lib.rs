@@ -24,6 +24,7 @@
 pub mod bench;
 pub mod camera;
 pub mod cli;
+mod exr_header;
 pub mod geometry;
 pub mod lights;
 pub mod material;

@@ -33,10 +33,12 @@
 //! and every layer it recognises: a prefix `n`
 //! with channels `n.R`, `n.G`, `n.B` becomes an RGB layer, a prefix with exactly one channel a
 //! scalar layer; other channels are ignored. Malformed, truncated or oversized files
-//! (more than [`MAX_PIXELS`] per part) give an [`OutputError`], never a panic.
+//! (more than [`MAX_PIXELS`] per part) give an [`OutputError`], never a panic; so do the lossy
+//! B44 compressions and blocks larger than their part, refused from the header before the
+//! decoder sees them (the checks the texture reader makes too).
 
 use std::fs::File;
-use std::io::{BufReader, Seek, SeekFrom};
+use std::io::{BufReader, Cursor, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use exr::prelude::{
@@ -275,18 +277,28 @@ pub struct Frame {
     pub exposure: Option<f32>,
 }
 
-/// Decodes every channel of every part, largest resolution level only.
+/// Decodes every channel of every part of the file at `path`, largest resolution level only.
 fn load_channels(path: &Path) -> Result<(Vec<Channel>, Frame), OutputError> {
+    let file = File::open(path).map_err(|e| OutputError::io(path, "opening the EXR failed", e))?;
+    load_channels_from(BufReader::new(file), path, u64::MAX)
+}
+
+/// [`load_channels`] from any reader (`path` names it in errors), refusing files of more than
+/// `max_samples` samples in all parts together.
+fn load_channels_from(
+    mut reader: impl Read + Seek,
+    path: &Path,
+    max_samples: u64,
+) -> Result<(Vec<Channel>, Frame), OutputError> {
     let exr_err = |source: exr::error::Error| OutputError::Exr {
         path: path.to_path_buf(),
         source,
     };
-    let file = File::open(path).map_err(|e| OutputError::io(path, "opening the EXR failed", e))?;
-    let mut reader = BufReader::new(file);
 
     // Check the sizes in the header before the decoder allocates anything for them.
     let meta = MetaData::read_from_buffered(&mut reader, false).map_err(exr_err)?;
     for header in meta.headers.iter() {
+        crate::exr_header::check_part(header).map_err(|m| OutputError::invalid(path, m))?;
         let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
         if w.saturating_mul(h) > MAX_PIXELS {
             return Err(OutputError::invalid(
@@ -312,6 +324,12 @@ fn load_channels(path: &Path) -> Result<(Vec<Channel>, Frame), OutputError> {
         .iter()
         .map(|h| h.layer_size.0 as u64 * h.layer_size.1 as u64 * h.channels.list.len() as u64)
         .sum();
+    if samples > max_samples {
+        return Err(OutputError::invalid(
+            path,
+            format!("the file holds {samples} samples, more than the {max_samples} allowed here"),
+        ));
+    }
     memory::probe(samples.saturating_mul(8), memory::READ_IMAGE).map_err(|source| {
         OutputError::Memory {
             path: path.to_path_buf(),
@@ -449,6 +467,26 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, OutputError> {
 /// Layers and alpha whose data window differs from the beauty image's are an error.
 pub fn read_exr_framed(path: &Path) -> Result<(ExrImage, Frame), OutputError> {
     let (channels, frame) = load_channels(path)?;
+    framed_image(path, channels, frame)
+}
+
+/// [`read_exr_framed`] of a file held in memory (`path` names it in errors), refusing files of
+/// more than `max_samples` samples (pixels times channels, all parts together) before decoding.
+pub fn decode_exr_framed(
+    bytes: &[u8],
+    path: &Path,
+    max_samples: u64,
+) -> Result<(ExrImage, Frame), OutputError> {
+    let (channels, frame) = load_channels_from(Cursor::new(bytes), path, max_samples)?;
+    framed_image(path, channels, frame)
+}
+
+/// The beauty image and layers of decoded `channels`, checked against the beauty's window.
+fn framed_image(
+    path: &Path,
+    channels: Vec<Channel>,
+    frame: Frame,
+) -> Result<(ExrImage, Frame), OutputError> {
     let beauty = beauty(path, &channels)?;
     let misplaced = |name: &str, origin: (i32, i32)| {
         OutputError::invalid(

@@ -46,7 +46,9 @@ pub use atomic::{
 #[cfg(feature = "harness")]
 pub use compare::{ErrorStats, RELATIVE_L1_OFFSET, compare};
 pub use error::OutputError;
-pub use exr::{ExrImage, Frame, read_exr, read_exr_framed, read_exr_rgb, write_exr};
+pub use exr::{
+    ExrImage, Frame, decode_exr_framed, read_exr, read_exr_framed, read_exr_rgb, write_exr,
+};
 #[cfg(feature = "harness")]
 pub use heatmap::{ErrorMetric, Heatmap, HeatmapOptions, HeatmapScale, error_heatmap};
 pub use image::{Layer, LayerData, RgbImage};
@@ -57,4 +59,4 @@ pub use ply::{SampleSet, read_ply, read_ply_with_comments, write_ply};
 pub use png::{read_png, write_png};
 #[cfg(feature = "harness")]
 pub use regions::{default_band_radius, shadow_edge_band, translucent_mask};
-pub use tile::{ExrTile, Placement, Region, read_exr_tile, write_exr_tile};
+pub use tile::{ExrTile, Placement, Region, decode_exr_tile, read_exr_tile, write_exr_tile};

@@ -14,7 +14,7 @@
 use std::fmt;
 use std::path::Path;
 
-use super::exr::{read_exr_framed, write_exr_placed};
+use super::exr::{Frame, decode_exr_framed, read_exr_framed, write_exr_placed};
 use super::image::MAX_PIXELS;
 use super::{ExrImage, Layer, OutputError, RgbImage};
 
@@ -205,7 +205,21 @@ pub struct ExrTile {
 /// window starts at (0, 0) and holds its data window (a whole image is the one tile that
 /// covers it).
 pub fn read_exr_tile(path: &Path) -> Result<ExrTile, OutputError> {
-    let (image, frame) = read_exr_framed(path)?;
+    tile_of(path, read_exr_framed(path)?)
+}
+
+/// [`read_exr_tile`] of a file held in memory (`path` names it in errors), refusing files of
+/// more than `max_samples` samples before decoding (see [`decode_exr_framed`]).
+pub fn decode_exr_tile(
+    bytes: &[u8],
+    path: &Path,
+    max_samples: u64,
+) -> Result<ExrTile, OutputError> {
+    tile_of(path, decode_exr_framed(bytes, path, max_samples)?)
+}
+
+/// The tile a decoded image and its frame describe, if they describe one.
+fn tile_of(path: &Path, (image, frame): (ExrImage, Frame)) -> Result<ExrTile, OutputError> {
     if frame.display_origin != (0, 0) {
         return Err(OutputError::invalid(
             path,
@@ -233,7 +247,8 @@ pub fn read_exr_tile(path: &Path) -> Result<ExrTile, OutputError> {
         return Err(OutputError::invalid(
             path,
             format!(
-                "the data window ({w}x{h} pixels at ({x0}, {y0})) is not inside the {dw}x{dh}                  display window"
+                "the data window ({w}x{h} pixels at ({x0}, {y0})) is not inside the {dw}x{dh} \
+                 display window"
             ),
         ));
     }
@@ -299,6 +314,23 @@ mod tests {
         assert_eq!(
             (tile.display, tile.region, tile.exposure),
             ((2, 3), Region::full(2, 3), None)
+        );
+
+        // A data window outside the display window is not a tile.
+        let mut bytes = std::fs::read(&path).unwrap();
+        let key = b"displayWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        for (i, v) in [0i32, 0, 3, 3].into_iter().enumerate() {
+            bytes[at + 4 * i..at + 4 * i + 4].copy_from_slice(&v.to_le_bytes());
+        }
+        let outside = dir.path("outside.exr");
+        std::fs::write(&outside, bytes).unwrap();
+        let e = read_exr_tile(&outside).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "the data window (2x3 pixels at (3, 1)) is not inside the 4x4 display window"
+            ),
+            "{e}"
         );
 
         // A region that does not fit the display window or the pixels is not written.

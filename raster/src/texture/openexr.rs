@@ -9,7 +9,7 @@
 //! Before anything is decoded, the headers are read and every part's size checked against the
 //! [`TextureLimits`], and the samples of all parts together against four channels of the
 //! largest allowed texture, so that a header cannot make the decoder allocate without bound.
-//! Each part's block (a tile, or a run of scan lines) is checked too: see [`check_block_size`].
+//! Each part's block size and compression are checked too: see [`crate::exr_header`].
 
 use std::io::Cursor;
 use std::path::Path;
@@ -19,74 +19,6 @@ use glam::Vec3;
 
 use super::image_formats::Decoded;
 use super::{TextureError, TextureLimits, TextureSource};
-
-/// Bytes a block may always hold, whatever the part's size: a tile overhanging a small image,
-/// or 256 scan lines of four float channels at the widest texture (16384 × 256 × 16 bytes).
-const BLOCK_BYTES_FLOOR: u64 = 64 << 20;
-
-/// Refuses B44 and B44A parts: `exr`'s B44 decoder does OpenEXR's unsigned 16-bit arithmetic
-/// with subtractions that wrap, which a build with overflow checks (tests, fuzzing, debug)
-/// turns into a panic on ordinary data. These lossy formats are meant for images to look at,
-/// not for textures read as data.
-fn check_compression(header: &exr::meta::header::Header, path: &Path) -> Result<(), TextureError> {
-    use exr::compression::Compression;
-    let name = match header.compression {
-        Compression::B44 => "B44",
-        Compression::B44A => "B44A",
-        _ => return Ok(()),
-    };
-    Err(TextureError::new(
-        path,
-        format!(
-            "OpenEXR {name} compression is not read (save the texture with ZIP, PIZ or no \
-             compression)"
-        ),
-    ))
-}
-
-/// Refuses a part whose blocks (tiles, or runs of scan lines) hold more bytes than the whole
-/// part, or than [`BLOCK_BYTES_FLOOR`] if that is more.
-///
-/// The decoder reads each block into a buffer of the size the header implies for a block
-/// before it finds out whether the file holds that many bytes, and the header's tile size is
-/// not tied to the image's: a 2.5 KB file declaring 64 × 16 449 600-pixel tiles on a 64 × 64
-/// image made it zero-fill a gigabyte. A real block is a piece of its image, so only a part
-/// smaller than one block (a tiny image in large tiles) comes near the bound.
-fn check_block_size(header: &exr::meta::header::Header, path: &Path) -> Result<(), TextureError> {
-    let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
-    let bytes_per_pixel = header.channels.bytes_per_pixel as u64;
-    let (block_pixels, what) = match header.blocks {
-        exr::meta::BlockDescription::Tiles(tiles) => {
-            let (tw, th) = (tiles.tile_size.0 as u64, tiles.tile_size.1 as u64);
-            (
-                tw.saturating_mul(th),
-                format!("tiles of {tw} × {th} pixels"),
-            )
-        }
-        exr::meta::BlockDescription::ScanLines => {
-            let lines = header.compression.scan_lines_per_block() as u64;
-            (
-                lines.saturating_mul(w),
-                format!("blocks of {lines} scan lines"),
-            )
-        }
-    };
-    let block_bytes = block_pixels.saturating_mul(bytes_per_pixel);
-    let allowed = w
-        .saturating_mul(h)
-        .saturating_mul(bytes_per_pixel)
-        .max(BLOCK_BYTES_FLOOR);
-    if block_bytes > allowed {
-        return Err(TextureError::new(
-            path,
-            format!(
-                "OpenEXR part of {w} × {h} pixels declares {what} ({block_bytes} bytes each, \
-                 more than the {allowed} bytes lucent allows a block of this part)"
-            ),
-        ));
-    }
-    Ok(())
-}
 
 /// Decodes an OpenEXR file held in memory.
 pub(super) fn decode_exr(
@@ -118,8 +50,7 @@ pub(super) fn decode_exr(
         let channels = header.channels.list.len() as u64;
         samples =
             samples.saturating_add((w as u64).saturating_mul(h as u64).saturating_mul(channels));
-        check_block_size(header, path)?;
-        check_compression(header, path)?;
+        crate::exr_header::check_part(header).map_err(|m| TextureError::new(path, m))?;
     }
     let max_samples = limits.max_texels.saturating_mul(4);
     if samples > max_samples {

@@ -17,11 +17,13 @@
 //! | [`shadow_rays_match_brute_force`] | BVH any-hit (plain, hinted) and closest hit against a brute-force loop |
 //! | [`convexity_is_sound`] | a mesh `cannot_shadow_itself` accepts is flat or convex by an exhaustive check |
 //! | [`texture_load_never_panics`] | arbitrary bytes as each texture format → a texture within the caps or an error |
+//! | [`exr_tile_read_never_panics`] | arbitrary bytes as an OpenEXR tile (`lucent merge`'s reader) → a tile whose images fit its window, or an error |
 //! | [`crops_match_the_whole_render`] | a crop of a render (any size, aa, method, interpolation, threads) is that region of the whole render, bit for bit |
 
 mod cache;
 mod convexity;
 mod crops;
+mod exr_tile;
 pub mod input;
 mod meshes;
 mod parse;
@@ -33,6 +35,7 @@ mod texture;
 pub use cache::{MAX_FUZZ_SAMPLES, cache_query_matches_exhaustive};
 pub use convexity::convexity_is_sound;
 pub use crops::crops_match_the_whole_render;
+pub use exr_tile::{MAX_EXR_SAMPLES, exr_tile_read_never_panics};
 pub use meshes::{gltf_load_never_panics, ply_load_never_panics};
 pub use parse::{SMALL_MESH_OBJ, fuzz_origin, obj_load_never_panics, scene_parse_never_panics};
 pub use raster::raster_triangle_in_bounds;
@@ -44,7 +47,7 @@ pub use texture::{FUZZ_LIMITS, texture_load_never_panics};
 pub type Property = fn(&[u8]);
 
 /// Every target by name, with its property: what the replay test and tools iterate over.
-pub const TARGETS: [(&str, Property); 11] = [
+pub const TARGETS: [(&str, Property); 12] = [
     (
         "cache_query_matches_exhaustive",
         cache_query_matches_exhaustive,
@@ -61,5 +64,6 @@ pub const TARGETS: [(&str, Property); 11] = [
     ),
     ("convexity_is_sound", convexity_is_sound),
     ("texture_load_never_panics", texture_load_never_panics),
+    ("exr_tile_read_never_panics", exr_tile_read_never_panics),
     ("crops_match_the_whole_render", crops_match_the_whole_render),
 ];

@@ -97,6 +97,11 @@ fn texture_load_never_panics() {
 }
 
 #[test]
+fn exr_tile_read_never_panics() {
+    replay("exr_tile_read_never_panics");
+}
+
+#[test]
 fn crops_match_the_whole_render() {
     replay("crops_match_the_whole_render");
 }

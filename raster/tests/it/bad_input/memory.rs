@@ -177,6 +177,63 @@ fn an_exr_larger_than_memory_is_refused_before_it_is_decoded() {
     );
 }
 
+/// A 64 × 64 OpenEXR of one uncompressed tile whose header then declares tiles of
+/// 64 × 16 449 600 pixels, and whose one chunk claims 1.06 GB: what the `exr` decoder would
+/// zero-fill before finding the file short (a fuzzed texture's shape, 49.6 KB).
+fn exr_with_a_tile_larger_than_its_image() -> Vec<u8> {
+    use exr::prelude::*;
+    const SIDE: usize = 64;
+    let channel = |name: &str| AnyChannel::new(name, FlatSamples::F32(vec![0.5; SIDE * SIDE]));
+    let encoding = Encoding {
+        compression: Compression::Uncompressed,
+        blocks: Blocks::Tiles(Vec2(SIDE, SIDE)),
+        line_order: LineOrder::Increasing,
+    };
+    let layer = Layer::new(
+        Vec2(SIDE, SIDE),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(SmallVec::from_vec(vec![
+            channel("R"),
+            channel("G"),
+            channel("B"),
+        ])),
+    );
+    let mut exr = Vec::new();
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(std::io::Cursor::new(&mut exr))
+        .expect("EXR writes");
+    let tiles = exr
+        .windows(15)
+        .position(|w| w == b"tiles\0tiledesc\0")
+        .expect("the file is tiled");
+    // Then the attribute's size (u32), the tile's width and height (u32 each).
+    let height = tiles + 15 + 4 + 4;
+    exr[height..height + 4].copy_from_slice(&16_449_600u32.to_le_bytes());
+    // The one chunk, last: tile x, y, level x, y (i32 each), its byte count, its pixels.
+    let data = SIDE * SIDE * 3 * 4;
+    let count = exr.len() - data - 4;
+    assert_eq!(exr[count..count + 4], (data as i32).to_le_bytes());
+    exr[count..count + 4].copy_from_slice(&1_060_000_000i32.to_le_bytes());
+    exr
+}
+
+/// An EXR whose tiles are far larger than its image is refused from its header by `merge`
+/// and `compare` (under 0.5 GiB of address space, where the decoder's gigabyte would abort).
+#[test]
+#[cfg(target_os = "linux")]
+fn an_exr_tile_larger_than_its_image_is_refused_before_it_is_decoded() {
+    let sb = Sandbox::new("memory-exr-tile").with_address_space(LIMIT_KIB / 3);
+    sb.write("tiles.exr", &exr_with_a_tile_larger_than_its_image());
+    let message = "tiles.exr: OpenEXR part of 64 × 64 pixels declares tiles of 64 × 16449600 \
+                   pixels (12633292800 bytes each, more than the 67108864 bytes lucent allows a \
+                   block of this part)";
+    sb.fails(&["merge", "tiles.exr", "-o", "out.png"], 1, &[message]);
+    sb.fails(&["compare", "tiles.exr", "tiles.exr"], 1, &[message]);
+}
+
 /// An OBJ larger than memory is refused with the size of what it needs: under 0.75 GiB of
 /// address space, its 1 GiB of text; under 1.2 GiB, which holds 512 MiB of text, what reading
 /// its statements may need (twice the text, asked for before the reading starts).

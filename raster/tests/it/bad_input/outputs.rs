@@ -155,6 +155,41 @@ fn compare_bad_images() {
     }
 }
 
+/// A B44-compressed EXR (lossy, and a decoder whose 16-bit arithmetic wraps: a panic in a
+/// build with overflow checks) is refused from its header by `compare` and `merge`.
+#[test]
+fn lossy_b44_exrs_are_refused() {
+    use exr::prelude::*;
+    let channel = |name: &str| AnyChannel::new(name, FlatSamples::F16(vec![f16::ONE; 8 * 8]));
+    let encoding = Encoding {
+        compression: Compression::B44,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let layer = Layer::new(
+        Vec2(8, 8),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(SmallVec::from_vec(vec![
+            channel("R"),
+            channel("G"),
+            channel("B"),
+        ])),
+    );
+    let mut b44 = Vec::new();
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(std::io::Cursor::new(&mut b44))
+        .expect("EXR writes");
+    let sb = Sandbox::new("out-b44");
+    sb.write("b.exr", &b44);
+    let message = "b.exr: OpenEXR B44 compression is not read (save the file with ZIP, PIZ or \
+                   no compression)";
+    sb.fails(&["compare", "b.exr", "b.exr"], 1, &[message]);
+    sb.fails(&["merge", "b.exr", "-o", "m.png"], 1, &[message]);
+    assert!(!sb.path("m.png").exists());
+}
+
 /// A reader that closes the pipe before the report comes (`lucent presets | head -0`): the
 /// output ends quietly with status 0, not a panic on the broken pipe.
 #[test]
