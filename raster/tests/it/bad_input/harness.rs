@@ -398,3 +398,27 @@ pub fn valid_png(sandbox: &Sandbox, name: &str, width: u32, height: u32) -> Vec<
         .expect("write a valid PNG");
     sandbox.read(name)
 }
+
+/// An OpenEXR of one `side × side` part whose channels `R`, `G`, `B` each hold `samples`,
+/// written by the `exr` crate with `encoding`.
+pub fn rgb_exr(
+    side: usize,
+    samples: exr::prelude::FlatSamples,
+    encoding: exr::prelude::Encoding,
+) -> Vec<u8> {
+    use exr::prelude::*;
+    let channels = ["R", "G", "B"].map(|name| AnyChannel::new(name, samples.clone()));
+    let layer = Layer::new(
+        Vec2(side, side),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(SmallVec::from_vec(channels.to_vec())),
+    );
+    let mut bytes = Vec::new();
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(std::io::Cursor::new(&mut bytes))
+        .expect("EXR writes");
+    bytes
+}

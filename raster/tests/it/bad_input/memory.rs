@@ -2,7 +2,7 @@
 //! what makes it smaller, never an abort. The binary runs under an address-space limit
 //! (`ulimit -v`), which makes the allocator refuse what a smaller machine would.
 
-use super::harness::{CONSTANT, Sandbox, scene};
+use super::harness::{CONSTANT, Sandbox, rgb_exr, scene};
 
 /// 1.5 GiB of address space: the binary, its threads and a small scene fit.
 const LIMIT_KIB: u64 = 3 << 19;
@@ -181,30 +181,14 @@ fn an_exr_larger_than_memory_is_refused_before_it_is_decoded() {
 /// 64 × 16 449 600 pixels, and whose one chunk claims 1.06 GB: what the `exr` decoder would
 /// zero-fill before finding the file short (a fuzzed texture's shape, 49.6 KB).
 fn exr_with_a_tile_larger_than_its_image() -> Vec<u8> {
-    use exr::prelude::*;
+    use exr::prelude::{Blocks, Compression, Encoding, FlatSamples, LineOrder, Vec2};
     const SIDE: usize = 64;
-    let channel = |name: &str| AnyChannel::new(name, FlatSamples::F32(vec![0.5; SIDE * SIDE]));
     let encoding = Encoding {
         compression: Compression::Uncompressed,
         blocks: Blocks::Tiles(Vec2(SIDE, SIDE)),
         line_order: LineOrder::Increasing,
     };
-    let layer = Layer::new(
-        Vec2(SIDE, SIDE),
-        LayerAttributes::default(),
-        encoding,
-        AnyChannels::sort(SmallVec::from_vec(vec![
-            channel("R"),
-            channel("G"),
-            channel("B"),
-        ])),
-    );
-    let mut exr = Vec::new();
-    Image::from_layer(layer)
-        .write()
-        .non_parallel()
-        .to_buffered(std::io::Cursor::new(&mut exr))
-        .expect("EXR writes");
+    let mut exr = rgb_exr(SIDE, FlatSamples::F32(vec![0.5; SIDE * SIDE]), encoding);
     let tiles = exr
         .windows(15)
         .position(|w| w == b"tiles\0tiledesc\0")

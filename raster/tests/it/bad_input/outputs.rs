@@ -1,7 +1,7 @@
 //! Output paths that cannot be written, and `compare` on bad images: nothing is written or
 //! replaced, and no temporary file is left behind.
 
-use super::harness::{CONSTANT, PREVIOUS, Sandbox, render, scene};
+use super::harness::{CONSTANT, PREVIOUS, Sandbox, render, rgb_exr, scene};
 
 /// PNG and EXR paths in a missing directory, naming a directory, or the same file twice:
 /// rejected before rendering, both outputs untouched.
@@ -159,28 +159,12 @@ fn compare_bad_images() {
 /// build with overflow checks) is refused from its header by `compare` and `merge`.
 #[test]
 fn lossy_b44_exrs_are_refused() {
-    use exr::prelude::*;
-    let channel = |name: &str| AnyChannel::new(name, FlatSamples::F16(vec![f16::ONE; 8 * 8]));
+    use exr::prelude::{Compression, Encoding, FlatSamples, f16};
     let encoding = Encoding {
         compression: Compression::B44,
         ..Encoding::FAST_LOSSLESS
     };
-    let layer = Layer::new(
-        Vec2(8, 8),
-        LayerAttributes::default(),
-        encoding,
-        AnyChannels::sort(SmallVec::from_vec(vec![
-            channel("R"),
-            channel("G"),
-            channel("B"),
-        ])),
-    );
-    let mut b44 = Vec::new();
-    Image::from_layer(layer)
-        .write()
-        .non_parallel()
-        .to_buffered(std::io::Cursor::new(&mut b44))
-        .expect("EXR writes");
+    let b44 = rgb_exr(8, FlatSamples::F16(vec![f16::ONE; 8 * 8]), encoding);
     let sb = Sandbox::new("out-b44");
     sb.write("b.exr", &b44);
     let message = "b.exr: OpenEXR B44 compression is not read (save the file with ZIP, PIZ or \
