@@ -642,6 +642,41 @@ def exr_tile_seeds():
     write(t, "layer-without-beauty", exr_scanlines(tile[4:7], (0, 0, 1, 2), (0, 0, 1, 2)))
 
 
+# ----------------------------------------------------------------------- samples_ply_read_never_panics
+def samples_ply_seeds():
+    t = "samples_ply_read_never_panics"
+    names = ["x", "y", "z", "nx", "ny", "nz", "area", "irradiance_r", "irradiance_g", "irradiance_b"]
+    samples = [(0, 0, 0, 0, 0, 1, 0.25, 1, 0.5, 0.25), (1, 0, 0, 1, 0, 0, 0.5, 0, 0, 0),
+               (0, 2, -1, 0, -1, 0, 0, 2, 2, 2)]
+
+    def ply(header_lines, body):
+        return ("\n".join(["ply"] + header_lines + ["end_header"]) + "\n").encode() + body
+
+    def floats(rows, order=names):
+        return b"".join(f32(row[names.index(n)]) for row in rows for n in order)
+
+    def header(count, props, fmt="binary_little_endian", extra=()):
+        return (["format %s 1.0" % fmt, "comment lucent sample-set v1", "comment seed 1",
+                 "element vertex %d" % count] + ["property float %s" % n for n in props] + list(extra))
+
+    write(t, "three-samples", ply(header(3, names), floats(samples)))
+    # Properties shuffled, a viewer's colour bytes between them, and an empty face element.
+    shuffled = names[5:] + names[:5]
+    colour_rows = b"".join(floats([row], shuffled[:4]) + bytes([255, 128]) + floats([row], shuffled[4:])
+                           for row in samples)
+    lines = (["format binary_little_endian 1.0", "element vertex 3"]
+             + ["property float %s" % n for n in shuffled[:4]]
+             + ["property uchar red", "property uchar green"]
+             + ["property float %s" % n for n in shuffled[4:]]
+             + ["element face 0", "property list uchar int vertex_indices"])
+    write(t, "shuffled-with-colours-and-faces", ply(lines, colour_rows))
+    write(t, "future-version", ply(header(3, names)[:1] + ["comment lucent sample-set v2"]
+                                   + header(3, names)[3:], floats(samples)))
+    write(t, "truncated", ply(header(3, names), floats(samples)[:-7]))
+    write(t, "ascii", ply(header(1, names, fmt="ascii"), b"0 0 0 0 0 1 1 1 1 1\n"))
+    write(t, "normal-not-unit", ply(header(1, names), floats([(0, 0, 0, 0, 0, 2, 1, 1, 1, 1)])))
+
+
 def crop_seed(scene=0, method=3, size=(40, 30), aa=1, step=1, tolerance=0.25, vfov=30.0,
               crop=(0, 0, 40, 30), threads_swapped=False):
     """One crops_match_the_whole_render input (layout in tests/src/fuzz_props/crops.rs)."""
@@ -694,4 +729,5 @@ if __name__ == "__main__":
     convexity_seeds()
     texture_seeds()
     exr_tile_seeds()
+    samples_ply_seeds()
     crop_seeds()

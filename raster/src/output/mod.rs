@@ -55,7 +55,7 @@ pub use image::{Layer, LayerData, RgbImage};
 pub use merge::{Merged, merge_tiles};
 #[cfg(feature = "harness")]
 pub use noise::{NoiseStats, seed_noise};
-pub use ply::{SampleSet, read_ply, read_ply_with_comments, write_ply};
+pub use ply::{SampleSet, decode_ply_with_comments, read_ply, read_ply_with_comments, write_ply};
 pub use png::{read_png, write_png};
 #[cfg(feature = "harness")]
 pub use regions::{default_band_radius, shadow_edge_band, translucent_mask};

@@ -18,6 +18,7 @@
 //! | [`convexity_is_sound`] | a mesh `cannot_shadow_itself` accepts is flat or convex by an exhaustive check |
 //! | [`texture_load_never_panics`] | arbitrary bytes as each texture format → a texture within the caps or an error |
 //! | [`exr_tile_read_never_panics`] | arbitrary bytes as an OpenEXR tile (`lucent merge`'s reader) → a tile whose images fit its window, or an error |
+//! | [`samples_ply_read_never_panics`] | arbitrary bytes as a baked sample set (`--samples-from`) → a valid set or an error |
 //! | [`crops_match_the_whole_render`] | a crop of a render (any size, aa, method, interpolation, threads) is that region of the whole render, bit for bit |
 
 mod cache;
@@ -28,6 +29,7 @@ pub mod input;
 mod meshes;
 mod parse;
 mod raster;
+mod samples_ply;
 mod shadow;
 mod table;
 mod texture;
@@ -39,6 +41,7 @@ pub use exr_tile::{MAX_EXR_SAMPLES, exr_tile_read_never_panics};
 pub use meshes::{gltf_load_never_panics, ply_load_never_panics};
 pub use parse::{SMALL_MESH_OBJ, fuzz_origin, obj_load_never_panics, scene_parse_never_panics};
 pub use raster::raster_triangle_in_bounds;
+pub use samples_ply::samples_ply_read_never_panics;
 pub use shadow::shadow_rays_match_brute_force;
 pub use table::table_lookup_finite;
 pub use texture::{FUZZ_LIMITS, texture_load_never_panics};
@@ -47,7 +50,7 @@ pub use texture::{FUZZ_LIMITS, texture_load_never_panics};
 pub type Property = fn(&[u8]);
 
 /// Every target by name, with its property: what the replay test and tools iterate over.
-pub const TARGETS: [(&str, Property); 12] = [
+pub const TARGETS: [(&str, Property); 13] = [
     (
         "cache_query_matches_exhaustive",
         cache_query_matches_exhaustive,
@@ -65,5 +68,9 @@ pub const TARGETS: [(&str, Property); 12] = [
     ("convexity_is_sound", convexity_is_sound),
     ("texture_load_never_panics", texture_load_never_panics),
     ("exr_tile_read_never_panics", exr_tile_read_never_panics),
+    (
+        "samples_ply_read_never_panics",
+        samples_ply_read_never_panics,
+    ),
     ("crops_match_the_whole_render", crops_match_the_whole_render),
 ];

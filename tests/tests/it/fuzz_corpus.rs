@@ -102,6 +102,11 @@ fn exr_tile_read_never_panics() {
 }
 
 #[test]
+fn samples_ply_read_never_panics() {
+    replay("samples_ply_read_never_panics");
+}
+
+#[test]
 fn crops_match_the_whole_render() {
     replay("crops_match_the_whole_render");
 }

@@ -51,7 +51,7 @@
 //!   finite area ≥ 0, finite irradiance ≥ 0 per channel. The error names the vertex index.
 
 use std::fs::File;
-use std::io::{BufReader, Read};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use glam::Vec3;
@@ -233,7 +233,23 @@ pub fn read_ply_with_comments(path: &Path) -> Result<(SampleSet, Vec<String>), O
         .metadata()
         .map_err(|e| OutputError::io(path, "reading the PLY's size failed", e))?
         .len();
-    let mut reader = BufReader::new(file);
+    read_samples(BufReader::new(file), file_len, path)
+}
+
+/// [`read_ply_with_comments`] of a file held in memory (`path` names it in errors).
+pub fn decode_ply_with_comments(
+    bytes: &[u8],
+    path: &Path,
+) -> Result<(SampleSet, Vec<String>), OutputError> {
+    read_samples(bytes, bytes.len() as u64, path)
+}
+
+/// Reads a sample set from `reader`, a file of `file_len` bytes that `path` names in errors.
+fn read_samples(
+    mut reader: impl BufRead,
+    file_len: u64,
+    path: &Path,
+) -> Result<(SampleSet, Vec<String>), OutputError> {
     let header = Header::parse(&mut reader).map_err(|e| OutputError::from((path, e)))?;
     let length = header.length;
     let header = sample_layout(path, header)?;
