@@ -130,7 +130,8 @@ pub fn poisson_samples_with_progress(
     let dist = AreaDistribution::new(triangles)?;
     let n = target.resolve(dist.total())? as usize;
     let m = n * CANDIDATE_RATIO;
-    let strata = Strata::new(triangles, dist.total(), m);
+    let bounds = vertex_bounds(triangles);
+    let strata = Strata::new(triangles, bounds, dist.total(), m);
     let steps = (3 + 8 * ROUNDS) as f32;
     let mut step = 0.0;
     let mut advance = || {
@@ -157,7 +158,7 @@ pub fn poisson_samples_with_progress(
     // 2. Tiles: counted, then filled.
     let d_max = hex_spacing(dist.total(), n as u32);
     let d_min = (d_max as f64 * (1.0 - weight_limit_power()) * BETA) as f32;
-    let (origin, _) = vertex_bounds(triangles);
+    let origin = bounds.0;
     // Cells slightly larger than d_max, so rounding in the cell coordinates cannot separate a
     // pair closer than d_max.
     let layout = Layout::new(origin, d_max * 1.0001);

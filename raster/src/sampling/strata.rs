@@ -34,7 +34,6 @@ use rayon::prelude::*;
 
 use super::rng::Pcg32;
 use super::surface::{SurfacePoint, triangle_area};
-use crate::geometry::vertex_bounds;
 
 /// Candidates one piece holds on average, at most (pieces are split until they hold fewer).
 const PIECE_CANDIDATES: f64 = 4.0;
@@ -89,14 +88,20 @@ fn piece_corners(levels: u32, index: u64) -> [Vec2; 3] {
 
 impl Strata {
     /// Strata for `m` candidates over `triangles` (finite, validated by the caller) of total
-    /// area `total`.
-    pub(super) fn new(triangles: &[[Vec3; 3]], total: f64, m: usize) -> Strata {
+    /// area `total`, whose vertices lie within `(lo, hi)` ([`vertex_bounds`]).
+    ///
+    /// [`vertex_bounds`]: crate::geometry::vertex_bounds
+    pub(super) fn new(
+        triangles: &[[Vec3; 3]],
+        (lo, hi): (Vec3, Vec3),
+        total: f64,
+        m: usize,
+    ) -> Strata {
         let max_area = PIECE_CANDIDATES * total / m.max(1) as f64;
         // Morton order of the centroids; ties (identical codes) keep the input order. Every
         // pass but the running sum is parallel and gives the serial result: the bounds are
         // exact (see `vertex_bounds`), and the sort's keys are distinct (the index is part of
         // them).
-        let (lo, hi) = vertex_bounds(triangles);
         let grid = Grid::new(lo, hi);
         let mut order: Vec<(u64, u32)> = triangles
             .par_iter()
@@ -182,6 +187,7 @@ impl Strata {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::vertex_bounds;
 
     #[test]
     fn pieces_tile_each_triangle_with_equal_areas() {
@@ -191,7 +197,7 @@ mod tests {
             Vec3::new(0.0, 4.0, 0.0),
         ];
         // 8 units² for 200 candidates: pieces of at most 0.16 → 4³ = 64 pieces of 0.125.
-        let s = Strata::new(&[tri], 8.0, 200);
+        let s = Strata::new(&[tri], vertex_bounds(&[tri]), 8.0, 200);
         assert_eq!(s.levels, [3]);
         assert!((s.cumulative.last().unwrap() - 8.0).abs() < 1e-9);
         // Every piece lies inside the parent and has 1/64 of its area; together they cover it
@@ -239,7 +245,7 @@ mod tests {
         // A 40 × 40 square of two triangles, 300k candidates: count per 4 × 4 box.
         let tris = crate::sampling::tests::square_40();
         let m = 300_000;
-        let s = Strata::new(&tris, 1600.0, m);
+        let s = Strata::new(&tris, vertex_bounds(&tris), 1600.0, m);
         let mut rng = Pcg32::new(1, 1);
         let mut counts = vec![0u32; 100];
         s.candidates(&tris, 0, m, m, &mut rng, |_, c| {
