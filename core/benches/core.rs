@@ -1,7 +1,8 @@
 //! Core micro-benchmarks (divan): `cargo bench -p lucent-core --bench core`.
 //!
-//! The data set is the talk's sphere: radius 1 cm, marble at 10 mm per unit, lit from +z so
-//! there is a terminator, 23k irradiance samples; queries at random points on the surface.
+//! The data set is the talk's sphere (`benches/sphere/mod.rs`): radius 1 cm, marble at 10 mm
+//! per unit, lit from +z so there is a terminator, 23k irradiance samples; queries at random
+//! points on the surface.
 //! Before the timings, `main` prints the cache's bytes per sample and the traversal statistics
 //! per method (nodes opened and profile evaluations per query), which divan cannot report.
 
@@ -10,82 +11,11 @@ use lucent_core::glam::Vec3;
 use lucent_core::internals::exhaustive_sum_lanes;
 use lucent_core::internals::{Lanes, NodeMoments, ScalarLanes, SimdLanes};
 use lucent_core::stats::{NoStats, QueryStats};
-use lucent_core::{
-    Distance, IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, ProfileModel,
-    QuerySettings, Sample, ShadingPoint,
-};
+use lucent_core::{Distance, IrradianceCache, Method, Profile, ProfileModel, QuerySettings};
 
-const N: usize = 23_000;
-const QUERIES: usize = 256;
+mod sphere;
 
-struct Rng(u64);
-impl Rng {
-    fn f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn on_sphere(&mut self) -> Vec3 {
-        let z = self.f32() * 2.0 - 1.0;
-        let phi = self.f32() * std::f32::consts::TAU;
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(s * phi.cos(), s * phi.sin(), z)
-    }
-}
-
-fn samples(n: usize) -> Vec<Sample> {
-    let mut rng = Rng(1);
-    let area = 4.0 * std::f32::consts::PI / n as f32;
-    (0..n)
-        .map(|_| {
-            let p = rng.on_sphere();
-            Sample {
-                position: p,
-                area,
-                irradiance: Vec3::splat(p.z.max(0.0)),
-            }
-        })
-        .collect()
-}
-
-struct Setup {
-    cache: IrradianceCache,
-    profile: Profile,
-    k: LocalTerm,
-    points: Vec<ShadingPoint>,
-    table: LocalIntegralTable,
-}
-
-fn setup() -> &'static Setup {
-    static SETUP: std::sync::OnceLock<Setup> = std::sync::OnceLock::new();
-    SETUP.get_or_init(|| {
-        let cache = IrradianceCache::build(&samples(N)).unwrap();
-        let profile =
-            Profile::from_preset(lucent_core::presets::find("marble").unwrap(), 10.0).unwrap();
-        let alpha = cache.smoothing_radius(1.5);
-        let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0).unwrap();
-        let k = table.local_term(profile.mean_free_path());
-        let mut rng = Rng(2);
-        let points = (0..QUERIES)
-            .map(|_| {
-                let p = rng.on_sphere();
-                ShadingPoint {
-                    position: p,
-                    irradiance: Vec3::splat(p.z.max(0.0)),
-                }
-            })
-            .collect();
-        Setup {
-            cache,
-            profile,
-            k,
-            points,
-            table,
-        }
-    })
-}
+use sphere::{QUERIES, samples, setup};
 
 fn settings_eps(method: Method, epsilon: f32) -> QuerySettings {
     QuerySettings {

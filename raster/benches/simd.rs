@@ -9,14 +9,15 @@
 use divan::{Bencher, black_box};
 use lucent_core::glam::Vec3;
 use lucent_core::stats::NoStats;
-use lucent_core::{
-    IrradianceCache, LocalIntegralTable, LocalTerm, Method, Profile, QuerySettings, Sample,
-    ShadingPoint,
-};
+use lucent_core::{Method, QuerySettings};
 use lucent_raster::render::simd::Avx2;
 
-const N: usize = 23_000;
-const QUERIES: usize = 256;
+/// The core's benchmark data set (only the table goes unread here).
+#[allow(dead_code)]
+#[path = "../../core/benches/sphere/mod.rs"]
+mod sphere;
+
+use sphere::{QUERIES, setup};
 
 fn main() {
     if Avx2::detect().is_none() {
@@ -24,71 +25,6 @@ fn main() {
         return;
     }
     divan::main();
-}
-
-/// SplitMix64 floats in [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn on_sphere(&mut self) -> Vec3 {
-        let z = self.f32() * 2.0 - 1.0;
-        let phi = self.f32() * std::f32::consts::TAU;
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(s * phi.cos(), s * phi.sin(), z)
-    }
-}
-
-struct Setup {
-    cache: IrradianceCache,
-    profile: Profile,
-    k: LocalTerm,
-    points: Vec<ShadingPoint>,
-}
-
-fn setup() -> &'static Setup {
-    static SETUP: std::sync::OnceLock<Setup> = std::sync::OnceLock::new();
-    SETUP.get_or_init(|| {
-        let mut rng = Rng(1);
-        let area = 4.0 * std::f32::consts::PI / N as f32;
-        let samples: Vec<Sample> = (0..N)
-            .map(|_| {
-                let p = rng.on_sphere();
-                Sample {
-                    position: p,
-                    area,
-                    irradiance: Vec3::splat(p.z.max(0.0)),
-                }
-            })
-            .collect();
-        let cache = IrradianceCache::build(&samples).unwrap();
-        let profile =
-            Profile::from_preset(lucent_core::presets::find("marble").unwrap(), 10.0).unwrap();
-        let alpha = cache.smoothing_radius(1.5);
-        let table = LocalIntegralTable::new(&profile, alpha, alpha / 1024.0).unwrap();
-        let k = table.local_term(profile.mean_free_path());
-        let mut rng = Rng(2);
-        let points = (0..QUERIES)
-            .map(|_| {
-                let p = rng.on_sphere();
-                ShadingPoint {
-                    position: p,
-                    irradiance: Vec3::splat(p.z.max(0.0)),
-                }
-            })
-            .collect();
-        Setup {
-            cache,
-            profile,
-            k,
-            points,
-        }
-    })
 }
 
 fn run(b: Bencher, method: Method, epsilon: f32, avx2: bool) {
