@@ -427,7 +427,9 @@ impl Builder<'_> {
     /// the traversal cost are added by the caller). The three axes are binned in one pass over
     /// `items`, each triangle's box read once (a pass per axis read them three times); above
     /// [`Builder::binned`] triangles, over every k-th of them. Both sides of the plane chosen
-    /// hold some of those, so neither side of the partition is empty.
+    /// hold some of those, so neither side of the partition is empty. (Tried: two sets of bins
+    /// filled by alternate triangles and merged, against store-to-load waits on runs of one
+    /// bin: no gain.)
     fn best_planes(&self, items: &[u32], cb: &Bounds) -> [Option<Split>; 3] {
         let extent = cb.max - cb.min;
         let spread = [0, 1, 2].map(|a| extent[a] > 0.0);
@@ -485,7 +487,11 @@ impl Builder<'_> {
 /// The bin of coordinate `x` of a box starting at `min`, `scale = BINS / extent`.
 #[inline(always)]
 fn bin_of(x: f32, min: f32, scale: f32) -> usize {
-    (((x - min) * scale) as usize).min(BINS - 1)
+    // Clamped as a float first (NaN to 0, as the saturating cast to usize does), then cast
+    // through i32: one truncation and two checks that never fail, where the cast to usize
+    // took two truncations and the fix-ups of a 64-bit unsigned saturation (the one-threaded
+    // build 15% faster).
+    ((x - min) * scale).max(0.0).min((BINS - 1) as f32) as i32 as usize
 }
 
 /// Collapses the binary tree into the 4-wide one that queries traverse. Each wide node takes
@@ -616,6 +622,49 @@ mod tests {
             grown.grow(b.center());
             bgrown.grow(bb.center());
             assert!(same(&grown, bgrown));
+        }
+    }
+
+    /// [`bin_of`] clamps before its cast; every input gets the bin of the saturating cast's
+    /// definition, so the trees are the same: bin edges and the values just beside them, the
+    /// extremes, NaN, infinities and random coordinates at every scale.
+    #[test]
+    fn bins_are_those_of_the_saturating_cast() {
+        let reference = |x: f32, min: f32, scale: f32| (((x - min) * scale) as usize).min(BINS - 1);
+        let mut rng = Pcg32::new(9, 3);
+        let mut cases = Vec::new();
+        for k in 0..=BINS + 1 {
+            let edge = k as f32 / BINS as f32;
+            for x in [edge, edge.next_up(), edge.next_down()] {
+                cases.push((x, 0.0, BINS as f32));
+            }
+        }
+        for x in [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+            f32::MIN,
+            -0.0,
+            0.0,
+        ] {
+            cases.push((x, 0.0, BINS as f32));
+            cases.push((1.0, x, BINS as f32));
+            cases.push((1.0, 0.0, x));
+        }
+        for _ in 0..100_000 {
+            let scale = [1e-30f32, 1e-3, 1.0, 1e4, 1e30][rng.next_u32() as usize % 5];
+            let min = (rng.next_f32() - 0.5) * scale;
+            let extent = rng.next_f32() * scale;
+            let x = min + (rng.next_f32() * 1.2 - 0.1) * extent;
+            cases.push((x, min, BINS as f32 / extent));
+        }
+        for (x, min, scale) in cases {
+            assert_eq!(
+                bin_of(x, min, scale),
+                reference(x, min, scale),
+                "{x} {min} {scale}"
+            );
         }
     }
 }
