@@ -13,6 +13,8 @@ use std::path::Path;
 
 use lucent_raster::output::decode_exr_tile;
 
+use super::assert_error_names_the_file;
+
 /// The most samples (pixels times channels, all parts) the fuzz target decodes: 2¹⁶.
 pub const MAX_EXR_SAMPLES: u64 = 1 << 16;
 
@@ -48,11 +50,7 @@ pub fn exr_tile_read_never_panics(data: &[u8]) {
             }
         }
         Err(e) => {
-            let message = e.to_string();
-            assert!(
-                message.starts_with(&format!("{name}: ")) && message.len() > name.len() + 12,
-                "unhelpful error: {message}"
-            );
+            assert_error_names_the_file(&e.to_string(), &format!("{name}: "), name);
         }
     }
 }

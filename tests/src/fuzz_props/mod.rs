@@ -74,3 +74,13 @@ pub const TARGETS: [(&str, Property); 13] = [
     ),
     ("crops_match_the_whole_render", crops_match_the_whole_render),
 ];
+
+/// The error of a reader given fuzz bytes as the file `name`: it starts with `prefix`, which
+/// names the file, and says what is wrong after it (more than a dozen characters beyond the
+/// name). Panics otherwise.
+fn assert_error_names_the_file(message: &str, prefix: &str, name: &str) {
+    assert!(
+        message.starts_with(prefix) && message.len() > name.len() + 12,
+        "unhelpful error: {message}"
+    );
+}

@@ -11,6 +11,8 @@ use std::path::Path;
 
 use lucent_raster::output::decode_ply_with_comments;
 
+use super::assert_error_names_the_file;
+
 /// The property of the fuzz target `samples_ply_read_never_panics` (see the module docs).
 pub fn samples_ply_read_never_panics(data: &[u8]) {
     let name = "t.ply";
@@ -28,11 +30,7 @@ pub fn samples_ply_read_never_panics(data: &[u8]) {
             }
         }
         Err(e) => {
-            let message = e.to_string();
-            assert!(
-                message.starts_with(name) && message.len() > name.len() + 12,
-                "unhelpful error: {message}"
-            );
+            assert_error_names_the_file(&e.to_string(), &format!("{name}: "), name);
         }
     }
 }

@@ -17,6 +17,8 @@ use std::path::Path;
 
 use lucent_raster::texture::{Texture, TextureEncoding, TextureFormat, TextureLimits};
 
+use super::assert_error_names_the_file;
+
 /// The caps the fuzz target decodes with: 1024 texels per side, 2¹⁶ in all.
 pub const FUZZ_LIMITS: TextureLimits = TextureLimits {
     max_side: 1024,
@@ -72,12 +74,7 @@ pub fn texture_load_never_panics(data: &[u8]) {
             }
         }
         Err(e) => {
-            let message = e.to_string();
-            assert!(
-                message.starts_with(&format!("texture {name}: "))
-                    && message.len() > name.len() + 12,
-                "unhelpful error: {message}"
-            );
+            assert_error_names_the_file(&e.to_string(), &format!("texture {name}: "), name);
         }
     }
 }
