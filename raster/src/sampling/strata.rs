@@ -39,6 +39,8 @@ use super::surface::{SurfacePoint, triangle_area};
 const PIECE_CANDIDATES: f64 = 4.0;
 /// Deepest subdivision (4¹² ≈ 17M pieces from one triangle).
 const MAX_LEVELS: u32 = 12;
+/// The sort key of a triangle without area, above every Morton code (63 bits).
+const NO_AREA: u64 = u64::MAX;
 
 /// The triangles in Morton order with their subdivision depths and cumulative areas.
 ///
@@ -101,16 +103,25 @@ impl Strata {
         // Morton order of the centroids; ties (identical codes) keep the input order. Every
         // pass but the running sum is parallel and gives the serial result: the bounds are
         // exact (see `vertex_bounds`), and the sort's keys are distinct (the index is part of
-        // them).
+        // them). Triangles without area get a key above every code (63 bits) and are cut off
+        // after the sort: a filter before it made rayon collect in pieces and join them.
         let grid = Grid::new(lo, hi);
         let mut order: Vec<(u64, u32)> = triangles
             .par_iter()
             .enumerate()
-            .filter(|(_, t)| triangle_area(t) > 0.0)
-            .map(|(i, t)| (grid.code((t[0] + t[1] + t[2]) / 3.0), i as u32))
+            .map(|(i, t)| {
+                let code = if triangle_area(t) > 0.0 {
+                    grid.code((t[0] + t[1] + t[2]) / 3.0)
+                } else {
+                    NO_AREA
+                };
+                (code, i as u32)
+            })
             .collect();
         order.par_sort_unstable();
-        let triangle: Vec<u32> = order.into_iter().map(|(_, i)| i).collect();
+        order.truncate(order.partition_point(|&(code, _)| code != NO_AREA));
+        let triangle: Vec<u32> = order.par_iter().map(|&(_, i)| i).collect();
+        drop(order);
         let (mut cumulative, levels): (Vec<f64>, Vec<u8>) = triangle
             .par_iter()
             .map(|&i| {
@@ -238,6 +249,38 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The triangles with area in the Morton order of their centroids, ties by index: the
+    /// definition, filtered and sorted on one thread.
+    #[test]
+    fn order_is_the_morton_order_of_the_triangles_with_area() {
+        let mut tris = crate::sampling::tests::sphere_over_floor(3);
+        for k in (0..tris.len()).step_by(7) {
+            let p = tris[k][1];
+            tris[k] = [p, p, p];
+        }
+        // Centroids in the far corner (the largest codes), and two identical triangles.
+        let (_, hi) = vertex_bounds(&tris);
+        let corner = [hi, hi - Vec3::X * 1e-3, hi - Vec3::Y * 1e-3];
+        tris.extend([corner, corner, [hi, hi, hi]]);
+        let bounds = vertex_bounds(&tris);
+        let grid = Grid::new(bounds.0, bounds.1);
+        let mut want: Vec<(u64, u32)> = tris
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| triangle_area(t) > 0.0)
+            .map(|(i, t)| (grid.code((t[0] + t[1] + t[2]) / 3.0), i as u32))
+            .collect();
+        want.sort();
+        assert!(want.len() < tris.len() - 100);
+        let total = tris.iter().map(triangle_area).sum();
+        let s = Strata::new(&tris, bounds, total, 10_000);
+        let want: Vec<u32> = want.into_iter().map(|(_, i)| i).collect();
+        assert_eq!(s.triangle, want);
+        assert_eq!(s.cumulative.len(), want.len());
+        // The grid's last cell on every axis: the largest code there is.
+        assert!(grid.code(Vec3::splat(f32::MAX)) < NO_AREA);
     }
 
     #[test]

@@ -83,7 +83,7 @@ use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::surface::{SurfacePoint, hex_spacing, triangle_area};
+use super::surface::{SurfacePoint, hex_spacing, ordered_sum, triangle_area};
 use cells::Cells;
 use clip::{
     Frame, Neighbour, Outcome, Polygon, box_distance2_below, box_distance2_below_all,
@@ -183,13 +183,18 @@ fn areas_of_cells(
             .collect(),
         stats: VoronoiStats::default(),
     };
-    let live: Vec<bool> = triangles.iter().map(|t| Frame::new(t).is_some()).collect();
-    let total: f64 = triangles
-        .iter()
-        .zip(&live)
-        .filter(|&(_, &l)| l)
-        .map(|(t, _)| triangle_area(t))
-        .sum();
+    let live: Vec<bool> = triangles
+        .par_iter()
+        .map(|t| Frame::new(t).is_some())
+        .collect();
+    // A triangle without a frame has no area (or a non-finite one): it adds nothing.
+    let total = ordered_sum(triangles.len(), |t| {
+        if live[t] {
+            triangle_area(&triangles[t])
+        } else {
+            0.0
+        }
+    });
     let (count, lo, hi) = sites.iter().filter(|p| p.is_finite()).fold(
         (0usize, Vec3::INFINITY, Vec3::NEG_INFINITY),
         |(n, l, h), &p| (n + 1, l.min(p), h.max(p)),
@@ -226,6 +231,7 @@ fn areas_of_cells(
     progress(0.55);
     let pass = Pass {
         triangles,
+        live: &live,
         owners: &owners,
         cells: &cells,
         reach2: reach * reach,
@@ -258,6 +264,8 @@ struct Piece {
 /// One run over an object's sites.
 struct Pass<'a> {
     triangles: &'a [[Vec3; 3]],
+    /// Whether each triangle has a frame (an area): the others are skipped.
+    live: &'a [bool],
     /// The site holding each triangle wholly, or [`SHARED`] (`owners.rs`).
     owners: &'a [u32],
     cells: &'a Cells,
@@ -343,8 +351,7 @@ impl Pass<'_> {
         let redo: Vec<u32> = (0..self.triangles.len() as u32)
             .filter(|&t| {
                 let f = flags[t as usize].load(Ordering::Relaxed);
-                Frame::new(&self.triangles[t as usize]).is_some()
-                    && (f & TOUCHED == 0 || f & INCOMPLETE != 0)
+                self.live[t as usize] && (f & TOUCHED == 0 || f & INCOMPLETE != 0)
             })
             .collect();
         stats.redone = redo.len() as u64;
