@@ -9,6 +9,8 @@
 
 use std::fmt;
 
+use rayon::prelude::*;
+
 /// A kind of buffer, as an [`OutOfMemory`] error names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Buffer {
@@ -141,6 +143,17 @@ pub fn collect<T>(
     Ok(v)
 }
 
+/// [`collect`] on every thread: the items of `iter`, in order, in a buffer allocated fallibly.
+pub fn par_collect<T: Send>(
+    iter: impl IndexedParallelIterator<Item = T>,
+    buffer: Buffer,
+) -> Result<Vec<T>, OutOfMemory> {
+    let mut v = with_capacity(iter.len(), buffer)?;
+    // The capacity is there already: rayon writes the items in place.
+    v.par_extend(iter);
+    Ok(v)
+}
+
 /// Whether the allocator grants `bytes` at once, asked and given back before work that will
 /// need about that much in many smaller buffers. It reserves address space without touching
 /// it, so it is cheap; it catches an address-space limit (`ulimit -v`) or a request beyond
@@ -190,6 +203,8 @@ mod tests {
         );
         assert!(with_capacity::<u8>(usize::MAX, TEST).is_err());
         assert!(collect(usize::MAX / 2, [1u32], TEST).is_err());
+        let refused = par_collect((0..usize::MAX / 8).into_par_iter().map(|i| i as u32), TEST);
+        assert_eq!(refused.unwrap_err().bytes, (usize::MAX / 8) as u64 * 4);
         let err = probe(u64::MAX, TEST).unwrap_err();
         assert_eq!(err.bytes, u64::MAX);
         assert!(probe(1 << 63, TEST).is_err());
@@ -199,6 +214,18 @@ mod tests {
     fn granted_buffers_hold_what_was_asked() {
         assert_eq!(filled(3, 7u8, TEST).unwrap(), vec![7, 7, 7]);
         assert_eq!(collect(2, [1, 2], TEST).unwrap(), vec![1, 2]);
+        let squares = par_collect(
+            (0..100_000u32).into_par_iter().map(|i| i as u64 * i as u64),
+            TEST,
+        )
+        .unwrap();
+        assert!(
+            squares
+                .iter()
+                .enumerate()
+                .all(|(i, &s)| s == (i * i) as u64)
+        );
+        assert_eq!(squares.len(), 100_000);
         assert!(with_capacity::<f32>(10, TEST).unwrap().capacity() >= 10);
         assert_eq!(probe(1 << 20, TEST), Ok(()));
     }

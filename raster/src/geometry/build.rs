@@ -16,6 +16,7 @@
 //! reports a hit on them).
 
 use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
 
 use crate::memory::{self, OutOfMemory};
 
@@ -165,11 +166,15 @@ pub(super) fn build_with(
     binned: usize,
 ) -> Result<Built, OutOfMemory> {
     let triangles = &triangles[..triangles.len().min(MAX_TRIANGLES)];
-    let mut boxes = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
+    let boxes = memory::par_collect(
+        triangles
+            .par_iter()
+            .map(|t| Bounds::of(&Aabb::from_triangle(t))),
+        memory::TRIANGLES,
+    )?;
     let mut order = memory::with_capacity(triangles.len(), memory::TRIANGLES)?;
     let mut skipped = Vec::new();
     for (i, t) in triangles.iter().enumerate() {
-        boxes.push(Bounds::of(&Aabb::from_triangle(t)));
         if t.iter().all(|v| v.is_finite()) {
             order.push(i as u32);
         } else {

@@ -23,6 +23,7 @@
 use std::fmt;
 
 use glam::{Vec3, Vec4};
+use rayon::prelude::*;
 
 use super::aabb::{Aabb, RayLanes};
 use super::build::{self, MAX_DEPTH, MAX_LEAF, MAX_TRIANGLES, SMALL_STACK, WIDE_STACK};
@@ -153,9 +154,8 @@ impl Bvh {
         let wide = build::collapse(&nodes)?;
         let bounds = nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds);
         drop(nodes);
-        let tris = memory::collect(
-            order.len(),
-            order.iter().map(|&i| triangles[i as usize]),
+        let tris = memory::par_collect(
+            order.par_iter().map(|&i| triangles[i as usize]),
             memory::TRIANGLES,
         )?;
         Ok(Bvh {

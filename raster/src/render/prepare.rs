@@ -2,6 +2,7 @@
 //! materials resolved into shaders, and the shadow-ray BVH — only when something can occlude.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::RenderError;
 use super::convexity::cannot_shadow_itself;
@@ -66,10 +67,15 @@ impl<'s> Prepared<'s> {
         for (i, object) in scene.objects.iter().enumerate() {
             first_triangle.push(triangles.len() as u32);
             let p = &object.mesh.positions;
-            for t in &object.mesh.triangles {
-                triangles.push([p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]]);
-                object_of.push(i as u32);
-            }
+            // In the capacity reserved above: on every thread, in place.
+            triangles.par_extend(
+                object
+                    .mesh
+                    .triangles
+                    .par_iter()
+                    .map(|t| [p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]]),
+            );
+            object_of.resize(triangles.len(), i as u32);
         }
         first_triangle.push(triangles.len() as u32);
         let (lo, hi) = vertex_bounds(&triangles);
