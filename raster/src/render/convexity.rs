@@ -21,7 +21,10 @@
 //! itself (correct, only slower). A mesh with many faces tests [`PROBE_FACES`] of them first,
 //! evenly spread: when their visits extrapolate to well over the cap, it is given up then,
 //! not after spending the whole cap (a UV sphere of two million faces would need 1.7 times
-//! the cap). A flat mesh is recognised first, in one pass. Before the tree is built,
+//! the cap). A mesh of hundreds of thousands of faces is first probed against a sketch of the
+//! tree, over the corners of a few thousand faces ([`sketched_work`]): a probe of the whole
+//! tree costs the tree, a second of CPU or more at millions of faces. A flat mesh is
+//! recognised first, in one pass. Before the tree is built,
 //! [`SCANNED_FACES`] faces spread over the mesh are tested against every vertex directly: a
 //! mesh that is not convex (a scan, a character) nearly always fails one of them, and then
 //! never pays for the tree.
@@ -60,23 +63,39 @@ const PROBE_MARGIN: f64 = 1.25;
 const MARGIN: f64 = 1e-9;
 /// Vertices per leaf of the box tree.
 const LEAF: usize = 8;
+/// Faces whose corners make the sketch of a large mesh's tree ([`sketched_work`]); a mesh of
+/// at least [`SKETCHED_ABOVE`] times as many faces is sketched before anything else.
+const SKETCH_FACES: usize = 16_384;
+/// See [`SKETCH_FACES`].
+const SKETCHED_ABOVE: usize = 16;
 
 /// True if no ray leaving a point of the mesh towards a light (from the side the light is on)
 /// can hit the mesh again: every vertex lies behind or on the plane of every face (within the
 /// tolerance), which includes flat meshes. Meshes too large for the exhaustive test within
 /// `WORK_LIMIT`, and meshes with non-finite positions, are taken to shadow themselves.
 pub fn cannot_shadow_itself(mesh: &Mesh) -> bool {
-    cannot_shadow_itself_within(mesh, WORK_LIMIT).0
+    cannot_shadow_itself_within(mesh, WORK_LIMIT, SKETCH_FACES).0
 }
 
 /// [`cannot_shadow_itself`] with a budget of `limit` box and vertex visits, and the visits
-/// made.
-fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64) -> (bool, u64) {
+/// made; a mesh of at least [`SKETCHED_ABOVE`] × `sketch` faces is sketched from `sketch`.
+fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64, sketch: usize) -> (bool, u64) {
     let Some((origin, diagonal)) = bounds(&mesh.positions) else {
         return (true, 0);
     };
     if !diagonal.is_finite() {
         return (false, 0);
+    }
+    // Millions of faces: the whole tree and what comes before it cost about 0.35 µs of CPU a
+    // vertex (1.4 s on 7.8 M faces), which a mesh far over the budget need not pay to be
+    // given up.
+    if mesh.triangles.len() >= SKETCHED_ABOVE * sketch {
+        let Some((estimate, visits)) = sketched_work(mesh, origin, diagonal, sketch) else {
+            return (false, 0);
+        };
+        if estimate > limit as f64 {
+            return (false, visits);
+        }
     }
     // A mesh whose test does not fit in memory is taken to shadow itself, like one whose test
     // exceeds the work limit.
@@ -163,6 +182,57 @@ fn scanned_face_fails(faces: &Faces, vertices: &[Vertex], tolerance: f64) -> Opt
         .map(|k| (k as u64 + 1) * scanned.len() as u64)
 }
 
+/// The whole test's box and vertex visits estimated from a sketch of the tree, and the visits
+/// that took; `None` if a face has a vertex in front of it or the sketch does not fit in
+/// memory (either way the mesh is taken to shadow itself).
+///
+/// The sketch is the tree over the corners of `sketch` faces spread evenly over the mesh (each
+/// corner with its face's normal), probed by [`PROBE_FACES`] faces spread likewise. It is
+/// shallower than the whole tree, and the visits per face grow with the depth (see
+/// `the_work_is_bounded`), so the estimate is low: 0.67 and 0.72 of the probe's on UV spheres
+/// of 7.8 M and 2 M faces. An estimate above the budget therefore says that the whole test
+/// would be given up too, for a few milliseconds instead of the tree's second or more. A face
+/// failing against the sketch's corners (mesh vertices) fails the full test too.
+fn sketched_work(mesh: &Mesh, origin: DVec3, diagonal: f64, sketch: usize) -> Option<(f64, u64)> {
+    let count = mesh.triangles.len();
+    let corners = mesh
+        .triangles
+        .iter()
+        .step_by((count / sketch.max(1)).max(1))
+        .flat_map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
+            let normal = (b - a).cross(c - a);
+            let normal = if normal.is_finite() {
+                normal
+            } else {
+                DVec3::ZERO
+            };
+            [a, b, c].map(|at| Vertex {
+                at: at - origin,
+                normal,
+            })
+        });
+    let tree = VertexTree::build(corners.collect()).ok()?;
+    let (tolerance, margin, apart) = (
+        TOLERANCE * diagonal,
+        MARGIN * diagonal,
+        DEGENERATE * diagonal,
+    );
+    let (mut visits, mut probed) = (0u64, 0u64);
+    for face in (0..count as u32).step_by((count / PROBE_FACES).max(1)) {
+        let Some(plane) = plane_of(mesh, origin, apart, face) else {
+            continue;
+        };
+        let (passed, v) = tree.nothing_in_front(&plane, tolerance, margin);
+        visits += v;
+        probed += 1;
+        if !passed {
+            return None;
+        }
+    }
+    Some((visits as f64 / probed.max(1) as f64 * count as f64, visits))
+}
+
 /// The smallest corner of the positions' bounding box and its diagonal's length, in f64 (the
 /// f32 length overflows for coordinates beyond about 10¹⁹); `None` for no positions.
 fn bounds(positions: &[Vec3]) -> Option<(DVec3, f64)> {
@@ -231,19 +301,7 @@ impl<'m> Faces<'m> {
 
     /// The plane of `face`, if it has one worth testing.
     fn try_plane(&self, face: u32) -> Option<Plane> {
-        let t = self.mesh.triangles[face as usize];
-        let [a, b, c] = t.map(|i| self.mesh.positions[i as usize].as_dvec3());
-        let apart = self.apart;
-        if a.distance(b) <= apart || b.distance(c) <= apart || a.distance(c) <= apart {
-            return None;
-        }
-        let n = (b - a).cross(c - a);
-        let area = n.length();
-        (area > 0.0 && area.is_finite()).then(|| Plane {
-            at: a - self.origin,
-            normal: n / area,
-            area,
-        })
+        plane_of(self.mesh, self.origin, self.apart, face)
     }
 
     /// The plane of a face of [`Faces::with_plane`].
@@ -251,6 +309,23 @@ impl<'m> Faces<'m> {
         self.try_plane(face)
             .expect("a face listed as having a plane has one")
     }
+}
+
+/// The plane of `face` relative to `origin`, if its corners are pairwise farther apart than
+/// `apart` and its normal is non-zero.
+fn plane_of(mesh: &Mesh, origin: DVec3, apart: f64, face: u32) -> Option<Plane> {
+    let t = mesh.triangles[face as usize];
+    let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
+    if a.distance(b) <= apart || b.distance(c) <= apart || a.distance(c) <= apart {
+        return None;
+    }
+    let n = (b - a).cross(c - a);
+    let area = n.length();
+    (area > 0.0 && area.is_finite()).then(|| Plane {
+        at: a - origin,
+        normal: n / area,
+        area,
+    })
 }
 
 /// Every face's plane, in face order (for the tests' references).
@@ -691,8 +766,8 @@ mod tests {
         // The budget stops the test: the sphere is then taken to shadow itself.
         let sphere = shapes::sphere(1.0, 64);
         let needed = (small.0 * sphere.triangles.len() as f64) as u64;
-        assert!(cannot_shadow_itself_within(&sphere, needed + 1000).0);
-        assert!(!cannot_shadow_itself_within(&sphere, needed / 2).0);
+        assert!(cannot_shadow_itself_within(&sphere, needed + 1000, SKETCH_FACES).0);
+        assert!(!cannot_shadow_itself_within(&sphere, needed / 2, SKETCH_FACES).0);
     }
 
     #[test]
@@ -704,10 +779,11 @@ mod tests {
         assert!(convex);
         let needed = (per_face * faces as f64) as u64;
         // Within the budget: the probe, then the whole test, passes.
-        let (passed, work) = cannot_shadow_itself_within(&sphere, needed + needed / 4);
+        let (passed, work) =
+            cannot_shadow_itself_within(&sphere, needed + needed / 4, SKETCH_FACES);
         assert!(passed && work >= needed, "{work} visits for {needed}");
         // Far over it: given up after the probe's visits, not after the budget's.
-        let (passed, work) = cannot_shadow_itself_within(&sphere, needed / 4);
+        let (passed, work) = cannot_shadow_itself_within(&sphere, needed / 4, SKETCH_FACES);
         assert!(!passed);
         let probe = (2.0 * per_face * PROBE_FACES as f64) as u64;
         assert!(
@@ -720,11 +796,57 @@ mod tests {
         for t in &mut inverted.triangles {
             t.swap(1, 2);
         }
-        let (passed, work) = cannot_shadow_itself_within(&inverted, WORK_LIMIT);
+        let (passed, work) = cannot_shadow_itself_within(&inverted, WORK_LIMIT, SKETCH_FACES);
         assert!(
             !passed && work <= sphere.positions.len() as u64,
             "{work} visits"
         );
+    }
+
+    /// The sketch's estimate is below the whole test's work, and not far below.
+    #[test]
+    fn the_sketch_estimates_the_work_from_below() {
+        let sphere = shapes::sphere(1.0, 256);
+        let (per_face, _) = visits_per_face(&sphere);
+        let needed = per_face * sphere.triangles.len() as f64;
+        let (origin, diagonal) = bounds(&sphere.positions).expect("vertices");
+        for sketch in [1024, 4096] {
+            let (estimate, visits) =
+                sketched_work(&sphere, origin, diagonal, sketch).expect("convex");
+            assert!(
+                estimate < needed && estimate > 0.4 * needed,
+                "{estimate} from {sketch} faces' corners, {needed} needed"
+            );
+            assert!(visits < 2 * PROBE_FACES as u64 * per_face as u64);
+        }
+        let mut inverted = sphere.clone();
+        for t in &mut inverted.triangles {
+            t.swap(1, 2);
+        }
+        assert!(sketched_work(&inverted, origin, diagonal, 1024).is_none());
+    }
+
+    /// A mesh far over the budget is given up after the sketch's probe, before its tree is
+    /// built; within the budget the sketch changes nothing.
+    #[test]
+    fn a_mesh_far_over_the_budget_is_given_up_by_its_sketch() {
+        let sphere = shapes::sphere(1.0, 256);
+        let sketch = 2048;
+        assert!(sphere.triangles.len() >= SKETCHED_ABOVE * sketch);
+        let (per_face, _) = visits_per_face(&sphere);
+        let needed = (per_face * sphere.triangles.len() as f64) as u64;
+        let (origin, diagonal) = bounds(&sphere.positions).expect("vertices");
+        let (_, sketch_visits) = sketched_work(&sphere, origin, diagonal, sketch).unwrap();
+        assert_eq!(
+            cannot_shadow_itself_within(&sphere, needed / 4, sketch),
+            (false, sketch_visits)
+        );
+        let (passed, work) = cannot_shadow_itself_within(&sphere, needed + needed / 4, sketch);
+        assert!(passed && work >= needed, "{work} visits for {needed}");
+        // Not sketched below the size: the probe of the whole tree gives it up.
+        let (passed, work) =
+            cannot_shadow_itself_within(&sphere, needed / 4, sphere.triangles.len());
+        assert!(!passed && work != sketch_visits);
     }
 
     /// A bumpy sphere (not convex, its dents hidden from most faces' planes by the bumps
