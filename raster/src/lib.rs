@@ -30,6 +30,7 @@ pub mod lights;
 pub mod material;
 pub mod memory;
 pub mod output;
+mod parallel;
 #[cfg(feature = "harness")]
 pub mod plot;
 pub mod raster;

@@ -2,9 +2,9 @@
 //! candidates that sample elimination thins out.
 
 use glam::{Vec2, Vec3};
-use rayon::prelude::*;
 
 use super::error::{MAX_SAMPLES, SamplingError};
+use crate::parallel::{first_where, ordered_sum};
 use crate::scene::SampleDensity;
 
 /// A point on a mesh.
@@ -99,30 +99,6 @@ pub fn total_area(triangles: &[[Vec3; 3]]) -> f64 {
     ordered_sum(triangles.len(), |i| triangle_area(&triangles[i]))
 }
 
-/// Terms [`ordered_sum`] holds at a time (8 MB).
-const SUM_BLOCK: usize = 1 << 20;
-
-/// `Σ term(i)` for `i` in `0..n`, added one by one in index order as a serial loop adds them,
-/// so with the same bits for any thread count; the terms are computed on every thread, a
-/// block at a time. (Millions of triangles' areas took a tenth of a second on one thread.)
-pub(crate) fn ordered_sum(n: usize, term: impl Fn(usize) -> f64 + Sync) -> f64 {
-    ordered_sum_in_blocks(n, SUM_BLOCK, term)
-}
-
-/// [`ordered_sum`] with `block` terms at a time.
-fn ordered_sum_in_blocks(n: usize, block: usize, term: impl Fn(usize) -> f64 + Sync) -> f64 {
-    let mut total = 0.0;
-    let mut terms = Vec::with_capacity(n.min(block));
-    for start in (0..n).step_by(block.max(1)) {
-        terms.clear();
-        terms.par_extend((start..n.min(start + block)).into_par_iter().map(&term));
-        for &t in &terms {
-            total += t;
-        }
-    }
-    total
-}
-
 /// The validated triangle set: every vertex finite, at most `u32::MAX` triangles, positive
 /// total area. (Candidates themselves come from [`super::strata::Strata`].)
 pub(super) struct AreaDistribution {
@@ -138,10 +114,7 @@ impl AreaDistribution {
             });
         }
         let non_finite = |t: &[Vec3; 3]| t.iter().position(|v| !v.is_finite());
-        if let Some(i) = triangles
-            .par_iter()
-            .position_first(|t| non_finite(t).is_some())
-        {
+        if let Some(i) = first_where(triangles, |t| non_finite(t).is_some()) {
             let t = &triangles[i];
             let k = non_finite(t).unwrap_or(0);
             return Err(SamplingError::NonFiniteVertex {
@@ -169,38 +142,6 @@ impl AreaDistribution {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::raster::testutil::Rng;
-
-    /// The sum in blocks on any number of threads has the bits of the serial loop, on terms
-    /// of every magnitude (where the order of the additions shows in the result).
-    #[test]
-    fn ordered_sum_has_the_serial_bits() {
-        let mut rng = Rng::new(11);
-        let terms: Vec<f64> = (0..5000)
-            .map(|_| (rng.f32_in(0.0, 1.0) as f64) * 10f64.powi((rng.f32_in(-8.0, 8.0)) as i32))
-            .collect();
-        let mut serial = 0.0;
-        for &t in &terms {
-            serial += t;
-        }
-        // A different order gives other bits on these terms, so the test can tell.
-        assert_ne!(terms.iter().rev().sum::<f64>().to_bits(), serial.to_bits());
-        for threads in [1, 2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            for block in [1, 7, 64, 4999, 5000, 100_000] {
-                let sum = pool.install(|| ordered_sum_in_blocks(terms.len(), block, |i| terms[i]));
-                assert_eq!(
-                    sum.to_bits(),
-                    serial.to_bits(),
-                    "{threads} threads, blocks of {block}"
-                );
-            }
-        }
-        assert_eq!(ordered_sum(0, |_| 1.0), 0.0);
-    }
 
     /// The first non-finite vertex in input order is the one reported.
     #[test]

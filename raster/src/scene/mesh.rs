@@ -2,8 +2,10 @@
 //! (scale, rotate, translate), smooth vertex normals, and the invariants of [`Mesh`].
 
 use glam::{Mat3, Mat4, Quat, Vec3};
+use rayon::prelude::*;
 
 use super::model::Mesh;
+use crate::parallel::first_where;
 
 /// Placement of an object: `world = translate + R · (scale · local)`, with the rotation made of
 /// `rotate_degrees.x` about the x axis first, then `.y` about y, then `.z` about z (fixed world
@@ -59,12 +61,12 @@ impl Transform {
             .into_iter()
             .fold(0.0f32, f32::max);
         let normal_matrix = (linear * (1.0 / largest)).inverse().transpose();
-        for p in &mut mesh.positions {
-            *p = m.transform_point3(*p);
-        }
-        for n in &mut mesh.normals {
-            *n = (normal_matrix * *n).normalize_or_zero();
-        }
+        mesh.positions
+            .par_iter_mut()
+            .for_each(|p| *p = m.transform_point3(*p));
+        mesh.normals
+            .par_iter_mut()
+            .for_each(|n| *n = (normal_matrix * *n).normalize_or_zero());
     }
 }
 
@@ -215,25 +217,22 @@ pub fn validate_mesh(mesh: &Mesh) -> Result<(), String> {
     if n > u32::MAX as usize {
         return Err(format!("too many vertices ({n})"));
     }
-    for (k, t) in mesh.triangles.iter().enumerate() {
-        if let Some(&i) = t.iter().find(|&&i| i as usize >= n) {
-            return Err(format!(
-                "triangle {k} uses vertex {i}, but there are only {n} vertices"
-            ));
-        }
+    // Each check on every thread; the first offender in order is the one named.
+    let out_of_range = |t: &[u32; 3]| t.iter().copied().find(|&i| i as usize >= n);
+    if let Some(k) = first_where(&mesh.triangles, |t| out_of_range(t).is_some()) {
+        let i = out_of_range(&mesh.triangles[k]).unwrap_or_default();
+        return Err(format!(
+            "triangle {k} uses vertex {i}, but there are only {n} vertices"
+        ));
     }
-    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+    if let Some(i) = first_where(&mesh.positions, |p| !p.is_finite()) {
         return Err(format!(
             "vertex {} has a non-finite position {:?}",
             i + 1,
             mesh.positions[i]
         ));
     }
-    if let Some(i) = mesh
-        .positions
-        .iter()
-        .position(|p| p.abs().max_element() > MAX_COORDINATE)
-    {
+    if let Some(i) = first_where(&mesh.positions, |p| p.abs().max_element() > MAX_COORDINATE) {
         return Err(format!(
             "vertex {} at {:?} is farther than {MAX_COORDINATE:e} units from the origin on \
              some axis (check the file's units and the object's scale)",
@@ -252,11 +251,9 @@ pub fn validate_mesh(mesh: &Mesh) -> Result<(), String> {
     if mesh.normals.len() != n {
         return Err(format!("{} normals for {n} vertices", mesh.normals.len()));
     }
-    if let Some(i) = mesh
-        .normals
-        .iter()
-        .position(|v| !v.is_finite() || (v.length() - 1.0).abs() > 1e-3)
-    {
+    if let Some(i) = first_where(&mesh.normals, |v| {
+        !v.is_finite() || (v.length() - 1.0).abs() > 1e-3
+    }) {
         return Err(format!(
             "vertex {} has an invalid normal {:?}",
             i + 1,
@@ -270,7 +267,7 @@ pub fn validate_mesh(mesh: &Mesh) -> Result<(), String> {
                 uvs.len()
             ));
         }
-        if let Some(i) = uvs.iter().position(|v| !v.is_finite()) {
+        if let Some(i) = first_where(uvs, |v| !v.is_finite()) {
             return Err(format!(
                 "vertex {} has non-finite texture coordinates {:?}",
                 i + 1,
@@ -409,6 +406,67 @@ mod tests {
         let mut m = good;
         m.normals[0] = Vec3::ZERO;
         assert!(validate_mesh(&m).unwrap_err().contains("normal"));
+    }
+
+    /// Checked on every thread, a mesh with several offenders of a kind names the first.
+    #[test]
+    fn validation_names_the_first_offender() {
+        let grid = 300u32;
+        let mut m = Mesh {
+            positions: (0..grid * grid)
+                .map(|k| Vec3::new((k % grid) as f32, (k / grid) as f32, 0.0))
+                .collect(),
+            normals: vec![Vec3::Z; (grid * grid) as usize],
+            uvs: Some(vec![glam::Vec2::ZERO; (grid * grid) as usize]),
+            triangles: (0..grid * (grid - 1))
+                .filter(|k| k % grid != grid - 1)
+                .map(|k| [k, k + 1, k + grid])
+                .collect(),
+        };
+        assert!(validate_mesh(&m).is_ok());
+        let far = grid * grid + 7;
+        let mut bad = m.clone();
+        for k in [60_000, 20_000, 80_000] {
+            bad.triangles[k] = [0, far, far + k as u32];
+        }
+        assert_eq!(
+            validate_mesh(&bad).unwrap_err(),
+            format!("triangle 20000 uses vertex {far}, but there are only 90000 vertices")
+        );
+        let mut bad = m.clone();
+        // The later one where a second thread would start.
+        bad.positions[45_001].y = f32::INFINITY;
+        bad.positions[44_000].x = f32::NAN;
+        assert!(
+            validate_mesh(&bad)
+                .unwrap_err()
+                .starts_with("vertex 44001 has a non-finite")
+        );
+        let mut bad = m.clone();
+        bad.positions[50_000].z = 1e30;
+        bad.positions[40_000].x = -1e30;
+        assert!(
+            validate_mesh(&bad)
+                .unwrap_err()
+                .starts_with("vertex 40001 at")
+        );
+        let mut bad = m.clone();
+        bad.normals[80_000] = Vec3::X * 2.0;
+        bad.normals[10_000] = Vec3::ZERO;
+        assert!(
+            validate_mesh(&bad)
+                .unwrap_err()
+                .starts_with("vertex 10001 has an invalid normal")
+        );
+        if let Some(uvs) = &mut m.uvs {
+            uvs[60_000].x = f32::NAN;
+            uvs[50_000].y = f32::NAN;
+        }
+        assert!(
+            validate_mesh(&m)
+                .unwrap_err()
+                .starts_with("vertex 50001 has non-finite")
+        );
     }
 
     #[test]

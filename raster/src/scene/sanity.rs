@@ -6,12 +6,13 @@
 //! same point ([`position_ids`]), because files split a vertex wherever its UV or normal
 //! changes, which would otherwise open every seam.
 
-use glam::{DVec3, Vec3};
-use rayon::slice::ParallelSliceMut;
+use glam::Vec3;
+use rayon::prelude::*;
 
 use super::mesh::{drop_unused_vertices, retain_flagged};
 use super::model::Mesh;
 use super::weld::position_ids;
+use crate::parallel::ordered_sum;
 
 /// A mesh's [`position_ids`], computed by the first check that needs them and shared by the
 /// checks after it (on a mesh of millions of vertices each computation sorts them all). They
@@ -126,20 +127,13 @@ pub fn is_closed_and_consistent(mesh: &Mesh, ids: &mut PositionIds) -> bool {
 /// seen from outside), by the divergence theorem: Σ (a − o) · ((b − o) × (c − o)) / 6 about
 /// the centroid o of the vertices (which keeps the terms small), in f64.
 pub fn signed_volume(mesh: &Mesh) -> f64 {
-    let n = mesh.positions.len().max(1) as f64;
-    let o = mesh
-        .positions
-        .iter()
-        .fold(DVec3::ZERO, |s, p| s + p.as_dvec3())
-        / n;
-    mesh.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3() - o);
-            a.dot(b.cross(c))
-        })
-        .sum::<f64>()
-        / 6.0
+    let (positions, triangles) = (&mesh.positions, &mesh.triangles);
+    let n = positions.len().max(1) as f64;
+    let o = ordered_sum(positions.len(), |i| positions[i].as_dvec3()) / n;
+    ordered_sum(triangles.len(), |k| {
+        let [a, b, c] = triangles[k].map(|i| positions[i as usize].as_dvec3() - o);
+        a.dot(b.cross(c))
+    }) / 6.0
 }
 
 /// Flips a closed, consistently wound mesh whose signed volume is negative (its triangles wind
@@ -178,22 +172,22 @@ pub fn orient_outward(
 /// product with the face's winding normal, counted per triangle corner; zero-area triangles do
 /// not vote): the file's normals and its winding disagree, and one of them is wrong.
 pub fn normals_against_winding(mesh: &Mesh) -> Option<String> {
-    let (mut against, mut with) = (0usize, 0usize);
-    for t in &mesh.triangles {
+    let votes = |t: &[u32; 3]| {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
         let face = (b - a).cross(c - a);
         if face == Vec3::ZERO || !face.is_finite() {
-            continue;
+            return (0, 0);
         }
-        for &i in t {
+        t.iter().fold((0, 0), |(against, with), &i| {
             let d = face.dot(mesh.normals[i as usize]);
-            if d < 0.0 {
-                against += 1;
-            } else if d > 0.0 {
-                with += 1;
-            }
-        }
-    }
+            (against + (d < 0.0) as usize, with + (d > 0.0) as usize)
+        })
+    };
+    let (against, with) = mesh
+        .triangles
+        .par_iter()
+        .map(votes)
+        .reduce(|| (0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
     (against > with).then(|| {
         format!(
             "{against} of {} vertex normals point against their triangle's winding \

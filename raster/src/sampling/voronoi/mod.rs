@@ -83,7 +83,8 @@ use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::surface::{SurfacePoint, hex_spacing, ordered_sum, triangle_area};
+use super::surface::{SurfacePoint, hex_spacing, triangle_area};
+use crate::parallel::ordered_sum;
 use cells::Cells;
 use clip::{
     Frame, Neighbour, Outcome, Polygon, box_distance2_below, box_distance2_below_all,
