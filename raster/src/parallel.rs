@@ -36,9 +36,10 @@ where
     total
 }
 
-/// Items per task of [`first_where`]: rayon's own search splits down to
-/// single items and checks the others' progress at each, which cost fifteen times a serial
-/// loop per item on millions of triangles.
+/// Items per task of [`first_where`]. Rayon's own search (`position_first`) splits down to
+/// single items and checks the other tasks' progress at each: on 7.8 M index triples it took
+/// 0.06 s on two threads, a serial loop 0.013 s, these chunks 0.014–0.017 s (a check that
+/// only reads is bound by memory; one that computes, such as a normal's length, gains).
 const SEARCH_CHUNK: usize = 1 << 14;
 
 /// The index of the first item of `items` for which `pred` holds, looked for on every thread.
