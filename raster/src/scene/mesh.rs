@@ -189,7 +189,7 @@ pub fn unit_normal(n: Vec3) -> Option<Vec3> {
 
 /// A loaded mesh's positions and UVs must be finite (vertex numbers 1-based, as in files).
 pub fn reject_non_finite(mesh: &Mesh) -> Result<(), String> {
-    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+    if let Some(i) = first_where(&mesh.positions, |p| !p.is_finite()) {
         return Err(format!(
             "vertex {} is not finite: {:?}",
             i + 1,
@@ -197,7 +197,7 @@ pub fn reject_non_finite(mesh: &Mesh) -> Result<(), String> {
         ));
     }
     if let Some(uvs) = &mesh.uvs
-        && let Some(i) = uvs.iter().position(|t| !t.is_finite())
+        && let Some(i) = first_where(uvs, |t| !t.is_finite())
     {
         return Err(format!(
             "texture coordinate of vertex {} is not finite: {:?}",
