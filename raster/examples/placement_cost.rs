@@ -30,6 +30,13 @@ fn cpu_seconds() -> f64 {
     (f[11] + f[12]) / 100.0
 }
 
+/// FNV-1a over the values' bits: equal output across builds and thread counts.
+fn fnv1a(values: impl Iterator<Item = f32>) -> u64 {
+    values.fold(0xcbf2_9ce4_8422_2325u64, |h, v| {
+        (h ^ v.to_bits() as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -56,21 +63,31 @@ fn main() {
         let points = poisson_samples(tris, SampleTarget::Count(n), 1).expect("samples");
         let (e_wall, e_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
         let sites: Vec<_> = points.iter().map(|p| p.position).collect();
-        // FNV-1a over the positions' bits: equal output across builds and thread counts.
-        let hash = sites
-            .iter()
-            .flat_map(|p| p.to_array())
-            .fold(0xcbf2_9ce4_8422_2325u64, |h, v| {
-                (h ^ v.to_bits() as u64).wrapping_mul(0x0100_0000_01b3)
-            });
+        let hash = fnv1a(sites.iter().flat_map(|p| p.to_array()));
         drop(points);
         let (t, c) = (Instant::now(), cpu_seconds());
         let areas = voronoi_areas(tris, &sites);
         let (v_wall, v_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
         assert_eq!(areas.areas.len(), n as usize);
+        let cells = fnv1a(
+            areas
+                .areas
+                .iter()
+                .copied()
+                .chain(areas.centroids.iter().flat_map(|c| {
+                    [
+                        c.position.x,
+                        c.position.y,
+                        c.position.z,
+                        c.bary.x,
+                        c.bary.y,
+                        f32::from_bits(c.triangle),
+                    ]
+                })),
+        );
         println!(
             "run {run}: elimination {e_wall:.3} s wall, {e_cpu:.2} s CPU; voronoi {v_wall:.3} s \
-             wall, {v_cpu:.2} s CPU; samples {hash:016x}"
+             wall, {v_cpu:.2} s CPU; samples {hash:016x}, cells {cells:016x}"
         );
         ew.push(e_wall);
         ec.push(e_cpu);

@@ -6,16 +6,23 @@
 //! cell_key:    [k0, k1, …]          occupied cells, ascending key
 //! cell_start:  [0, 3, 7, …, N]      sites of cell c: cell_start[c] .. cell_start[c + 1]
 //! slots:       open addressing, key → cell index (u32::MAX empty), 2× the cells
-//! tri_start:   [0, 2, 5, …]         triangles of cell c: tris[tri_start[c] .. tri_start[c + 1]],
-//! tris:        [t, t, …]            ascending
-//! block_start: [0, 1, 3, …]         runs of cell c: block_boxes[block_start[c] .. block_start[c + 1]]
-//! block_boxes: [[lo, hi], …]        the box of each run of BLOCK entries of a cell's triangles
+//! patch_start: [0, 16, 32, 33, …]   patch p: triangles patch_start[p] .. patch_start[p + 1]
+//! patch_box:   [[lo, hi], …]        the box of each patch's triangles with area
+//! list_start:  [0, 2, 5, …]         patches of cell c: patches[list_start[c] .. list_start[c + 1]],
+//! patches:     [p, p, …]            ascending
 //! ```
 //!
-//! About 23 bytes per site (12 position, 4 order, ~7 cells and slots) plus 4 per (cell,
-//! triangle) pair, about one pair per site on a mesh with fewer triangles than samples, and 24
-//! per run of up to [`BLOCK`] pairs. While the pairs are sorted by cell they are held twice,
-//! with 4 bytes per triangle.
+//! A **patch** is a run of up to [`PATCH`] consecutive triangles whose box spans at most a
+//! quarter of a cell, or a single larger triangle; the cells list patches rather than
+//! triangles. A mesh's triangles that are close in index are mostly close in space, so on a
+//! mesh much finer than the samples a patch holds [`PATCH`] triangles, and a cell's list is a
+//! tenth as long as a list of its triangles: registering 7.8 M triangles one by one made
+//! 42.6 M (cell, triangle) pairs, whose sort and run boxes took a third of the areas' time on
+//! one thread. Where the triangles are as large as the sample spacing, patches are single
+//! triangles and the lists are as before.
+//!
+//! About 23 bytes per site (12 position, 4 order, ~7 cells and slots), 28 per patch and 4 per
+//! (cell, patch) pair. While the pairs are sorted by cell they are held twice.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -25,11 +32,16 @@ use rayon::prelude::*;
 const AXIS_BITS: u32 = 21;
 const AXIS_MAX: i64 = (1 << AXIS_BITS) - 1;
 const EMPTY: u32 = u32::MAX;
-/// Triangles per parallel task when registering them with the cells.
-const REGISTER_CHUNK: usize = 4096;
-/// Entries of a cell's triangle list per bounding box: a site's or a centroid's search skips
-/// a run whose box is out of reach without looking at its triangles.
-const BLOCK: usize = 16;
+/// Triangles per parallel task when cutting them into patches. A multiple of [`PATCH`], and
+/// fixed, so that the patches are the same for any thread count.
+const PATCH_CHUNK: usize = 4096;
+/// Patches per parallel task when registering them with the cells.
+const REGISTER_CHUNK: usize = 1024;
+/// Most triangles in one patch: a site's or a centroid's search skips a patch whose box is
+/// out of reach without looking at its triangles.
+const PATCH: usize = 16;
+/// Largest extent of a patch of several triangles, in cells.
+const PATCH_EXTENT: f64 = 0.25;
 
 /// The grid (see the module documentation).
 pub(super) struct Cells {
@@ -45,13 +57,14 @@ pub(super) struct Cells {
     cell_start: Vec<u32>,
     slots: Vec<u32>,
     shift: u32,
-    tri_start: Vec<u32>,
-    tris: Vec<u32>,
-    /// The bounding box (lower, upper corner) of each run of [`BLOCK`] consecutive entries of
-    /// a cell's triangle list (a cell's last run may be shorter).
-    block_boxes: Vec<[Vec3; 2]>,
-    /// The runs of cell `c` are `block_boxes[block_start[c]..block_start[c + 1]]`.
-    block_start: Vec<u32>,
+    /// Patch `p` is the triangles `patch_start[p]..patch_start[p + 1]`.
+    patch_start: Vec<u32>,
+    /// The bounding box (lower, upper corner) of each patch's triangles with area (empty if
+    /// it has none).
+    patch_box: Vec<[Vec3; 2]>,
+    /// The patches of cell `c` are `patches[list_start[c]..list_start[c + 1]]`.
+    list_start: Vec<u32>,
+    patches: Vec<u32>,
 }
 
 fn pack(c: [i64; 3]) -> u64 {
@@ -86,10 +99,10 @@ impl Cells {
             cell_start: Vec::new(),
             slots: Vec::new(),
             shift: 0,
-            tri_start: Vec::new(),
-            tris: Vec::new(),
-            block_boxes: Vec::new(),
-            block_start: Vec::new(),
+            patch_start: Vec::new(),
+            patch_box: Vec::new(),
+            list_start: Vec::new(),
+            patches: Vec::new(),
         };
         // An indexed collect writes in place (a filtered one would gather pieces and copy
         // them, twice the memory); non-finite sites get a key above every cell's and are cut
@@ -189,16 +202,21 @@ impl Cells {
         self.cell_start[c] as usize..self.cell_start[c + 1] as usize
     }
 
-    /// The triangles registered with occupied cell `c`, ascending.
-    pub(super) fn triangles_of(&self, c: usize) -> &[u32] {
-        &self.tris[self.tri_start[c] as usize..self.tri_start[c + 1] as usize]
-    }
-
-    /// [`Cells::triangles_of`] in runs of [`BLOCK`], each with its bounding box.
-    pub(super) fn triangle_runs(&self, c: usize) -> impl Iterator<Item = (&[u32], &[Vec3; 2])> {
-        let boxes =
-            &self.block_boxes[self.block_start[c] as usize..self.block_start[c + 1] as usize];
-        self.triangles_of(c).chunks(BLOCK).zip(boxes)
+    /// The patches registered with occupied cell `c`, in ascending order: each its range of
+    /// triangles (some of which may have no area) and the bounding box of those with area.
+    pub(super) fn patches_of(
+        &self,
+        c: usize,
+    ) -> impl Iterator<Item = (std::ops::Range<u32>, &[Vec3; 2])> {
+        self.patches[self.list_start[c] as usize..self.list_start[c + 1] as usize]
+            .iter()
+            .map(|&p| {
+                let p = p as usize;
+                (
+                    self.patch_start[p]..self.patch_start[p + 1],
+                    &self.patch_box[p],
+                )
+            })
     }
 
     fn slot(&self, key: u64) -> usize {
@@ -246,10 +264,12 @@ impl Cells {
     }
 
     /// Registers with every occupied cell the triangles that come within `reach` (≤ the cell
-    /// size) of a point of the cell, and perhaps a few more: each triangle is cut into pieces
-    /// no larger than a cell (recursive longest-edge bisection), and each piece goes to the
-    /// occupied cells its bounding box, grown by `reach`, overlaps. `live[t]` is false for
-    /// triangles without area, which no cell gets.
+    /// size) of a point of the cell, and perhaps a few more, by patches (see the module
+    /// documentation). A patch of several triangles goes to the occupied cells its box, grown
+    /// by `reach`, overlaps. A single triangle is cut into pieces no larger than a cell
+    /// (recursive longest-edge bisection), and each piece goes to the occupied cells its box,
+    /// grown by `reach`, overlaps near its plane. `live[t]` is false for triangles without
+    /// area, which no cell gets for themselves (they may lie in a patch with others).
     pub(super) fn register_triangles(
         &mut self,
         triangles: &[[Vec3; 3]],
@@ -259,7 +279,7 @@ impl Cells {
         self.register_in_chunks(triangles, live, reach, REGISTER_CHUNK);
     }
 
-    /// [`Cells::register_triangles`], `chunk` triangles per parallel task (the lists are the
+    /// [`Cells::register_triangles`], `chunk` patches per parallel task (the lists are the
     /// same for every `chunk`).
     fn register_in_chunks(
         &mut self,
@@ -268,21 +288,47 @@ impl Cells {
         reach: f64,
         chunk: usize,
     ) {
-        // Per chunk of triangles, their cells one after the other and how many each has: no
-        // allocation per triangle (a list each took a quarter of the pass on 2 M triangles).
-        let chunks: Vec<(Vec<u32>, Vec<u32>)> = triangles
-            .par_chunks(chunk)
+        let extent = (PATCH_EXTENT * self.size) as f32;
+        let parts: Vec<(Vec<u32>, Vec<[Vec3; 2]>)> = triangles
+            .par_chunks(PATCH_CHUNK)
+            .enumerate()
+            .map(|(k, part)| {
+                let first = k * PATCH_CHUNK;
+                cut_into_patches(part, &live[first..first + part.len()], first, extent)
+            })
+            .collect();
+        let mut starts = Vec::with_capacity(triangles.len() / PATCH + parts.len() + 1);
+        let mut boxes = Vec::with_capacity(starts.capacity());
+        for (s, b) in parts {
+            starts.extend(s);
+            boxes.extend(b);
+        }
+        starts.push(triangles.len() as u32);
+        let (starts, boxes) = (starts, boxes);
+        // Per chunk of patches, their cells one after the other and how many each has: no
+        // allocation per patch (a list each took a quarter of the pass on 2 M triangles).
+        let chunks: Vec<(Vec<u32>, Vec<u32>)> = boxes
+            .par_chunks(chunk.max(1))
             .enumerate()
             .map(|(k, part)| {
                 let (mut cells, mut counts) = (Vec::new(), Vec::with_capacity(part.len()));
                 let (mut own, mut stack) = (Vec::new(), Vec::new());
-                for (i, tri) in part.iter().enumerate() {
+                for (i, &[lo, hi]) in part.iter().enumerate() {
+                    let p = k * chunk.max(1) + i;
+                    let range = starts[p] as usize..starts[p + 1] as usize;
                     own.clear();
-                    if live[k * chunk + i] {
-                        self.cells_near(tri, reach, &mut own, &mut stack);
-                        own.sort_unstable();
-                        own.dedup();
+                    let mut alive = range.clone().filter(|&t| live[t]);
+                    match (alive.next(), alive.next()) {
+                        (None, _) => {}
+                        (Some(t), None) => {
+                            self.cells_near(&triangles[t], reach, &mut own, &mut stack)
+                        }
+                        (Some(_), Some(_)) => {
+                            self.cells_near_box(lo.as_dvec3(), hi.as_dvec3(), reach, &mut own)
+                        }
                     }
+                    own.sort_unstable();
+                    own.dedup();
                     cells.extend_from_slice(&own);
                     counts.push(own.len() as u32);
                 }
@@ -298,7 +344,7 @@ impl Cells {
                 })
             })
         };
-        // Counting sort by cell; triangles are visited in index order, so each cell's list
+        // Counting sort by cell; patches are visited in index order, so each cell's list
         // comes out ascending.
         let mut start = vec![0u32; self.len() + 1];
         for list in lists() {
@@ -309,42 +355,18 @@ impl Cells {
         for c in 0..self.len() {
             start[c + 1] += start[c];
         }
-        let mut tris = vec![0u32; start[self.len()] as usize];
+        let mut patches = vec![0u32; start[self.len()] as usize];
         let mut next = start.clone();
-        for (t, list) in lists().enumerate() {
+        for (p, list) in lists().enumerate() {
             for &c in list {
-                tris[next[c as usize] as usize] = t as u32;
+                patches[next[c as usize] as usize] = p as u32;
                 next[c as usize] += 1;
             }
         }
-        // The runs' boxes. A mesh's triangles that are close in index are mostly close in
-        // space too, so the runs of an ascending list mostly have small boxes.
-        let mut runs = Vec::new();
-        let mut block_start = Vec::with_capacity(self.len() + 1);
-        block_start.push(0);
-        for c in 0..self.len() {
-            let end = start[c + 1] as usize;
-            runs.extend(
-                (start[c] as usize..end)
-                    .step_by(BLOCK)
-                    .map(|a| a..end.min(a + BLOCK)),
-            );
-            block_start.push(runs.len() as u32);
-        }
-        self.block_boxes = runs
-            .into_par_iter()
-            .map(|run| {
-                tris[run]
-                    .iter()
-                    .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], &t| {
-                        let [a, b, c] = triangles[t as usize];
-                        [lo.min(a).min(b).min(c), hi.max(a).max(b).max(c)]
-                    })
-            })
-            .collect();
-        self.block_start = block_start;
-        self.tris = tris;
-        self.tri_start = start;
+        self.patch_start = starts;
+        self.patch_box = boxes;
+        self.patches = patches;
+        self.list_start = start;
     }
 
     /// For a walk over the occupied cells in key order: the index of the first occupied cell
@@ -371,6 +393,20 @@ impl Cells {
             end += 1;
         }
         (self.cell_start[first], self.cell_start[end])
+    }
+
+    /// The occupied cells that the box `lo..hi`, grown by `reach`, overlaps.
+    fn cells_near_box(&self, lo: DVec3, hi: DVec3, reach: f64, out: &mut Vec<u32>) {
+        let (a, b) = (self.coords(lo - reach), self.coords(hi + reach));
+        for x in a[0]..=b[0] {
+            for y in a[1]..=b[1] {
+                for z in a[2]..=b[2] {
+                    if let Some(c) = self.find([x, y, z]) {
+                        out.push(c as u32);
+                    }
+                }
+            }
+        }
     }
 
     /// The occupied cells near a triangle (see [`Cells::register_triangles`]).
@@ -422,6 +458,45 @@ impl Cells {
     }
 }
 
+/// Cuts `part` (the triangles from index `first` on, `live` saying which have area) into
+/// patches: runs of up to [`PATCH`] consecutive triangles whose box of the triangles with area
+/// spans at most `extent`, a larger triangle alone. Returns each patch's first triangle and
+/// box. Greedy from the first triangle, so the patches depend only on the triangles.
+fn cut_into_patches(
+    part: &[[Vec3; 3]],
+    live: &[bool],
+    first: usize,
+    extent: f32,
+) -> (Vec<u32>, Vec<[Vec3; 2]>) {
+    let (mut starts, mut boxes) = (Vec::new(), Vec::new());
+    let mut t = 0;
+    while t < part.len() {
+        let start = t;
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let mut alive = 0;
+        while t < part.len() && t - start < PATCH {
+            if live[t] {
+                let [a, b, c] = part[t];
+                let (l, h) = (lo.min(a).min(b).min(c), hi.max(a).max(b).max(c));
+                if alive > 0 && !((h - l).max_element() <= extent) {
+                    break;
+                }
+                (lo, hi) = (l, h);
+                alive += 1;
+                if !((h - l).max_element() <= extent) {
+                    // A large triangle stays alone.
+                    t += 1;
+                    break;
+                }
+            }
+            t += 1;
+        }
+        starts.push((first + start) as u32);
+        boxes.push([lo, hi]);
+    }
+    (starts, boxes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -434,8 +509,15 @@ mod tests {
 
     #[test]
     fn triangles_register_alike_in_any_chunks_and_within_reach() {
-        // 5120 triangles, more than one chunk; every 50th has no area and registers nowhere.
+        // 5120 small triangles, more than one chunk, and two larger than a cell; every 50th
+        // has no area and registers nowhere.
         let mut tris = icosphere(4, Vec3::ZERO, 1.0);
+        tris.insert(3000, [Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]);
+        tris.push([
+            Vec3::new(0.0, -1.2, -1.2),
+            Vec3::new(0.0, 1.2, -1.2),
+            Vec3::Z,
+        ]);
         let live: Vec<bool> = (0..tris.len()).map(|t| t % 50 != 7).collect();
         for (t, tri) in tris.iter_mut().enumerate() {
             if !live[t] {
@@ -447,29 +529,69 @@ mod tests {
             .step_by(61)
             .map(|t| (t[0] + t[1] + t[2]) / 3.0)
             .collect();
-        let (size, reach) = (0.25, 0.1);
+        let (size, reach) = (0.5, 0.2);
         let register = |chunk: usize| {
             let mut cells = Cells::new(&sites, size);
             cells.register_in_chunks(&tris, &live, reach, chunk);
             cells
         };
         let cells = register(REGISTER_CHUNK);
-        let lists = |cells: &Cells| -> Vec<Vec<u32>> {
+        let lists = |cells: &Cells| -> Vec<Vec<std::ops::Range<u32>>> {
             (0..cells.len())
-                .map(|c| cells.triangles_of(c).to_vec())
+                .map(|c| cells.patches_of(c).map(|(range, _)| range).collect())
                 .collect()
         };
         let whole = lists(&register(usize::MAX));
         assert_eq!(lists(&cells), whole);
-        for chunk in [1, 7, 1000] {
+        for chunk in [1, 7, 100] {
             assert_eq!(lists(&register(chunk)), whole, "chunk {chunk}");
         }
-        // Each list ascends, holds no triangle without area, and holds every triangle that
-        // comes within the reach of its cell (tested at points spread over the triangle).
+        // The patches cut the triangles into consecutive runs within the chunks; each box is
+        // that of the patch's triangles with area, and spans at most a quarter of a cell
+        // unless the patch holds one of them.
+        let starts = &cells.patch_start;
+        assert_eq!(
+            (starts[0], starts[starts.len() - 1]),
+            (0, tris.len() as u32)
+        );
+        let mut several = 0;
+        for (p, w) in starts.windows(2).enumerate() {
+            let (a, b) = (w[0] as usize, w[1] as usize);
+            assert!(a < b && b - a <= PATCH, "patch {p}: {a}..{b}");
+            assert_eq!(
+                a / PATCH_CHUNK,
+                (b - 1) / PATCH_CHUNK,
+                "patch {p} crosses a chunk"
+            );
+            let alive: Vec<usize> = (a..b).filter(|&t| live[t]).collect();
+            let (lo, hi) =
+                alive
+                    .iter()
+                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &t| {
+                        let [x, y, z] = tris[t];
+                        (lo.min(x).min(y).min(z), hi.max(x).max(y).max(z))
+                    });
+            assert_eq!(cells.patch_box[p], [lo, hi], "patch {p}");
+            if alive.len() > 1 {
+                several += 1;
+                assert!((hi - lo).max_element() <= 0.25 * size as f32, "patch {p}");
+            }
+        }
+        assert!(several > 100, "{several} patches of several triangles");
+        assert!(
+            (1..starts.len())
+                .any(|p| starts[p] - starts[p - 1] == 1 && live[starts[p - 1] as usize])
+        );
+        // Each list ascends, holds no patch without a triangle with area, and covers every
+        // triangle that comes within the reach of its cell (tested at points spread over the
+        // triangle).
         let mut near = 0;
         for (c, list) in whole.iter().enumerate() {
-            assert!(list.windows(2).all(|w| w[0] < w[1]), "cell {c}");
-            assert!(list.iter().all(|&t| live[t as usize]), "cell {c}");
+            assert!(list.windows(2).all(|w| w[0].end <= w[1].start), "cell {c}");
+            assert!(
+                list.iter().all(|r| r.clone().any(|t| live[t as usize])),
+                "cell {c}"
+            );
             let lo =
                 cells.origin + DVec3::from_array(cells.cell_coords(c).map(|x| x as f64)) * size;
             for (t, tri) in tris.iter().enumerate().filter(|&(t, _)| live[t]) {
@@ -484,7 +606,7 @@ mod tests {
                 if touches {
                     near += 1;
                     assert!(
-                        list.binary_search(&(t as u32)).is_ok(),
+                        list.iter().any(|r| r.contains(&(t as u32))),
                         "cell {c}, triangle {t}"
                     );
                 }

@@ -59,8 +59,9 @@
 //! About 1.7 µs of CPU per sample on the bunny at 1M samples (1.3 triangles clipped per
 //! sample, each by the bisectors of the neighbours within twice the cell's radius, plus the
 //! neighbour sort); at most 33 bytes per sample of transient memory (`cells.rs`: positions,
-//! order and cells about 20, the areas 4, 4 per (cell, triangle) pair; the grid's sort peaks at
-//! 20), and 4 bytes per triangle for the owners. On a mesh finer than the samples most
+//! order and cells about 20, the areas 4, 4 per (cell, patch) pair; the grid's sort peaks at
+//! 20), 4 bytes per triangle for the owners, and about 2 per triangle for the patches of a mesh
+//! finer than the samples (28 per patch of up to 16 triangles). On a mesh finer than the samples most
 //! triangles have an owner: on a 2 M-triangle sphere with 23 000 samples the areas take a
 //! fifth less time than clipping every pair. Measured with the `voronoi_cost` example;
 //! figures in `BENCHMARKS.md`.
@@ -408,13 +409,17 @@ impl Pass<'_> {
             // Σ a and Σ a·(c − site) over the polygons.
             let (mut area, mut first) = (0.0, DVec3::ZERO);
             // Most of a grid cell's triangles are beyond the reach of each of its sites: the
-            // bounding boxes of runs of them, then of each, say so for a fraction of the exact
-            // test's cost.
-            for (run, [lo, hi]) in cells.triangle_runs(c) {
+            // bounding boxes of patches of them, then of each, say so for a fraction of the
+            // exact test's cost.
+            for (patch, [lo, hi]) in cells.patches_of(c) {
                 if box_distance2_below_all(ps, *lo, *hi) > self.reach2 {
                     continue;
                 }
-                for &t in run {
+                for t in patch {
+                    // A patch may hold triangles without area (they have no frame).
+                    if !self.live[t as usize] {
+                        continue;
+                    }
                     // Wholly another site's: clipping would leave nothing.
                     let owner = self.owners[t as usize];
                     if owner != SHARED && owner as usize != s {
@@ -625,9 +630,9 @@ impl Pass<'_> {
         }
     }
 
-    /// Each sorted site's centroid moved to the nearest point of the triangles registered to
-    /// its grid cell (which hold every triangle within the reach of its sites), ties to the
-    /// first; in sorted order.
+    /// Each sorted site's centroid moved to the nearest point of the triangles with area in
+    /// the patches registered to its grid cell (which hold every triangle within the reach of
+    /// its sites), ties to the first; in sorted order.
     fn centroids_on_surface(&self, sums: &[CellSum]) -> Vec<SurfacePoint> {
         let cells = self.cells;
         (0..cells.len())
@@ -636,12 +641,15 @@ impl Pass<'_> {
                 cells.sites_of(c).map(move |s| {
                     let p = sums[s].1.as_dvec3();
                     let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0], p);
-                    for (run, [lo, hi]) in cells.triangle_runs(c) {
+                    for (patch, [lo, hi]) in cells.patches_of(c) {
                         // Not nearer than the best so far (a tie keeps the first): skipped.
                         if box_distance2_below_all(p, *lo, *hi) >= best.0 {
                             continue;
                         }
-                        for &t in run {
+                        for t in patch {
+                            if !self.live[t as usize] {
+                                continue;
+                            }
                             let tri = &self.triangles[t as usize];
                             if box_distance2_below(p, tri) >= best.0 {
                                 continue;

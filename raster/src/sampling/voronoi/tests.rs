@@ -300,6 +300,23 @@ fn degenerate_triangles_own_nothing_and_non_finite_sites_are_skipped() {
 }
 
 #[test]
+fn centroids_lie_on_triangles_with_area() {
+    // An L of two unit squares, in z = 0 and in x = 0, and one site on their shared edge: its
+    // cell is the whole L, whose centroid (1/4, 1/2, 1/4) lies off both. A triangle shrunk to
+    // a point right there has no area, and lies among the floor's triangles in their patches.
+    let mut tris = grid(Vec3::ZERO, Vec3::X, Vec3::Y, 8, 8);
+    let c = Vec3::new(0.25, 0.5, 0.25);
+    tris.insert(70, [c; 3]);
+    tris.extend(grid(Vec3::ZERO, Vec3::Y, Vec3::Z, 8, 8));
+    let r = voronoi_areas(&tris, &[Vec3::new(0.0, 0.5, 0.0)]);
+    assert!((r.areas[0] - 2.0).abs() < 1e-6, "{}", r.areas[0]);
+    assert_ne!(r.centroids[0].triangle, 70);
+    check_on_surface(&tris, &r);
+    let off = r.centroids[0].position.distance(c);
+    assert!((off - 0.25).abs() < 1e-5, "{off}");
+}
+
+#[test]
 fn thin_sheets_and_holes_keep_the_sum_exact() {
     // Two parallel squares 0.02 apart (far thinner than the spacing) with samples on both:
     // cells reach through, the sum stays exact.
