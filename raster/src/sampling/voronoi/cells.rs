@@ -10,6 +10,8 @@
 //! patch_box:   [[lo, hi], …]        the box of each patch's triangles with area
 //! list_start:  [0, 2, 5, …]         patches of cell c: patches[list_start[c] .. list_start[c + 1]],
 //! patches:     [p, p, …]            ascending
+//! run_start:   [0, 1, 3, …]         runs of cell c: run_boxes[run_start[c] .. run_start[c + 1]]
+//! run_boxes:   [[lo, hi], …]        the box of each run of RUN entries of a cell's patches
 //! ```
 //!
 //! A **patch** is a run of up to [`PATCH`] consecutive triangles whose box spans at most a
@@ -21,8 +23,9 @@
 //! one thread. Where the triangles are as large as the sample spacing, patches are single
 //! triangles and the lists are as before.
 //!
-//! About 23 bytes per site (12 position, 4 order, ~7 cells and slots), 28 per patch and 4 per
-//! (cell, patch) pair. While the pairs are sorted by cell they are held twice.
+//! About 23 bytes per site (12 position, 4 order, ~7 cells and slots), 28 per patch, 4 per
+//! (cell, patch) pair and 24 per run of up to [`RUN`] pairs. While the pairs are sorted by cell
+//! they are held twice.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -34,12 +37,16 @@ const AXIS_MAX: i64 = (1 << AXIS_BITS) - 1;
 const EMPTY: u32 = u32::MAX;
 /// Triangles per parallel task when cutting them into patches. A multiple of [`PATCH`], and
 /// fixed, so that the patches are the same for any thread count.
-const PATCH_CHUNK: usize = 4096;
+pub(super) const PATCH_CHUNK: usize = 4096;
 /// Patches per parallel task when registering them with the cells.
 const REGISTER_CHUNK: usize = 1024;
 /// Most triangles in one patch: a site's or a centroid's search skips a patch whose box is
 /// out of reach without looking at its triangles.
 const PATCH: usize = 16;
+/// Entries of a cell's patch list per bounding box: a search skips a run whose box is out of
+/// reach without looking at its patches (where patches are single triangles, it would
+/// otherwise test each triangle's box twice).
+const RUN: usize = 16;
 /// Largest extent of a patch of several triangles, in cells.
 const PATCH_EXTENT: f64 = 0.25;
 
@@ -65,6 +72,11 @@ pub(super) struct Cells {
     /// The patches of cell `c` are `patches[list_start[c]..list_start[c + 1]]`.
     list_start: Vec<u32>,
     patches: Vec<u32>,
+    /// The bounding box of each run of [`RUN`] consecutive entries of a cell's patch list (a
+    /// cell's last run may be shorter).
+    run_boxes: Vec<[Vec3; 2]>,
+    /// The runs of cell `c` are `run_boxes[run_start[c]..run_start[c + 1]]`.
+    run_start: Vec<u32>,
 }
 
 fn pack(c: [i64; 3]) -> u64 {
@@ -103,6 +115,8 @@ impl Cells {
             patch_box: Vec::new(),
             list_start: Vec::new(),
             patches: Vec::new(),
+            run_boxes: Vec::new(),
+            run_start: Vec::new(),
         };
         // An indexed collect writes in place (a filtered one would gather pieces and copy
         // them, twice the memory); non-finite sites get a key above every cell's and are cut
@@ -202,21 +216,31 @@ impl Cells {
         self.cell_start[c] as usize..self.cell_start[c + 1] as usize
     }
 
-    /// The patches registered with occupied cell `c`, in ascending order: each its range of
-    /// triangles (some of which may have no area) and the bounding box of those with area.
-    pub(super) fn patches_of(
+    /// Patch `p`: its range of triangles and the bounding box of those with area.
+    pub(super) fn patch(&self, p: usize) -> (std::ops::Range<u32>, &[Vec3; 2]) {
+        (
+            self.patch_start[p]..self.patch_start[p + 1],
+            &self.patch_box[p],
+        )
+    }
+
+    /// The patches whose triangles lie in `triangles` (a range that starts and ends at patch
+    /// boundaries, such as a multiple of [`PATCH_CHUNK`]).
+    pub(super) fn patches_within(
         &self,
-        c: usize,
-    ) -> impl Iterator<Item = (std::ops::Range<u32>, &[Vec3; 2])> {
-        self.patches[self.list_start[c] as usize..self.list_start[c + 1] as usize]
-            .iter()
-            .map(|&p| {
-                let p = p as usize;
-                (
-                    self.patch_start[p]..self.patch_start[p + 1],
-                    &self.patch_box[p],
-                )
-            })
+        triangles: std::ops::Range<usize>,
+    ) -> std::ops::Range<usize> {
+        let starts = &self.patch_start[..self.patch_start.len() - 1];
+        let at = |t: usize| starts.partition_point(|&s| (s as usize) < t);
+        at(triangles.start)..at(triangles.end)
+    }
+
+    /// The patches registered with occupied cell `c`, ascending, in runs of up to [`RUN`],
+    /// each with the bounding box of its patches' boxes.
+    pub(super) fn patch_runs(&self, c: usize) -> impl Iterator<Item = (&[u32], &[Vec3; 2])> {
+        let list = &self.patches[self.list_start[c] as usize..self.list_start[c + 1] as usize];
+        let boxes = &self.run_boxes[self.run_start[c] as usize..self.run_start[c + 1] as usize];
+        list.chunks(RUN).zip(boxes)
     }
 
     fn slot(&self, key: u64) -> usize {
@@ -363,6 +387,30 @@ impl Cells {
                 next[c as usize] += 1;
             }
         }
+        let mut runs = Vec::new();
+        let mut run_start = Vec::with_capacity(self.len() + 1);
+        run_start.push(0);
+        for c in 0..self.len() {
+            let end = start[c + 1] as usize;
+            runs.extend(
+                (start[c] as usize..end)
+                    .step_by(RUN)
+                    .map(|a| a..end.min(a + RUN)),
+            );
+            run_start.push(runs.len() as u32);
+        }
+        self.run_boxes = runs
+            .into_par_iter()
+            .map(|run| {
+                patches[run]
+                    .iter()
+                    .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], &p| {
+                        let [a, b] = boxes[p as usize];
+                        [lo.min(a), hi.max(b)]
+                    })
+            })
+            .collect();
+        self.run_start = run_start;
         self.patch_start = starts;
         self.patch_box = boxes;
         self.patches = patches;
@@ -538,7 +586,11 @@ mod tests {
         let cells = register(REGISTER_CHUNK);
         let lists = |cells: &Cells| -> Vec<Vec<std::ops::Range<u32>>> {
             (0..cells.len())
-                .map(|c| cells.patches_of(c).map(|(range, _)| range).collect())
+                .map(|c| {
+                    let runs = cells.patch_runs(c);
+                    runs.flat_map(|(run, _)| run.iter().map(|&p| cells.patch(p as usize).0))
+                        .collect()
+                })
                 .collect()
         };
         let whole = lists(&register(usize::MAX));

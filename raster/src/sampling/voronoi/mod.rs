@@ -409,62 +409,69 @@ impl Pass<'_> {
             // Σ a and Σ a·(c − site) over the polygons.
             let (mut area, mut first) = (0.0, DVec3::ZERO);
             // Most of a grid cell's triangles are beyond the reach of each of its sites: the
-            // bounding boxes of patches of them, then of each, say so for a fraction of the
-            // exact test's cost.
-            for (patch, [lo, hi]) in cells.patches_of(c) {
+            // bounding boxes of runs of patches of them, then of each patch and each triangle,
+            // say so for a fraction of the exact test's cost.
+            for (run, [lo, hi]) in cells.patch_runs(c) {
                 if box_distance2_below_all(ps, *lo, *hi) > self.reach2 {
                     continue;
                 }
-                for t in patch {
-                    // A patch may hold triangles without area (they have no frame).
-                    if !self.live[t as usize] {
+                for &p in run {
+                    let (patch, [lo, hi]) = cells.patch(p as usize);
+                    // A single triangle's box is tested below.
+                    if patch.len() > 1 && box_distance2_below_all(ps, *lo, *hi) > self.reach2 {
                         continue;
                     }
-                    // Wholly another site's: clipping would leave nothing.
-                    let owner = self.owners[t as usize];
-                    if owner != SHARED && owner as usize != s {
-                        continue;
-                    }
-                    let tri = &self.triangles[t as usize];
-                    if box_distance2_below(ps, tri) > self.reach2
-                        || distance2_to_triangle(ps, tri) > self.reach2
-                    {
-                        continue;
-                    }
-                    let Some(frame) = Frame::new(tri) else {
-                        continue;
-                    };
-                    let mut outcome = Outcome::Done;
-                    if owner == SHARED {
-                        counts[0] += 1;
-                        outcome = scratch.polygon.clip_cell(
-                            &frame,
-                            ps,
-                            &cells.sites,
-                            &neighbours,
-                            sorted,
-                            guaranteed,
-                        );
-                    } else {
-                        counts[3] += 1;
-                        scratch.polygon.whole(&frame, ps);
-                    }
-                    if let Outcome::NeedMore(r2) = outcome {
-                        counts[1] += 1;
-                        outcome = self.clip_wide(s, ps, &frame, r2, scratch);
-                    }
-                    if outcome != Outcome::Done {
-                        continue;
-                    }
-                    let (a, c) = scratch.polygon.moment();
-                    area += a;
-                    first += (frame.point(c.x, c.y) - ps) * a;
-                    let mut flag = if a > 0.0 { TOUCHED } else { 0 };
-                    if !self.leads_to_processing(&scratch.polygon, tri, self.reach2) {
-                        flag |= INCOMPLETE;
-                    }
-                    if flag != 0 {
-                        flags[t as usize].fetch_or(flag, Ordering::Relaxed);
+                    for t in patch {
+                        // A patch may hold triangles without area (they have no frame).
+                        if !self.live[t as usize] {
+                            continue;
+                        }
+                        // Wholly another site's: clipping would leave nothing.
+                        let owner = self.owners[t as usize];
+                        if owner != SHARED && owner as usize != s {
+                            continue;
+                        }
+                        let tri = &self.triangles[t as usize];
+                        if box_distance2_below(ps, tri) > self.reach2
+                            || distance2_to_triangle(ps, tri) > self.reach2
+                        {
+                            continue;
+                        }
+                        let Some(frame) = Frame::new(tri) else {
+                            continue;
+                        };
+                        let mut outcome = Outcome::Done;
+                        if owner == SHARED {
+                            counts[0] += 1;
+                            outcome = scratch.polygon.clip_cell(
+                                &frame,
+                                ps,
+                                &cells.sites,
+                                &neighbours,
+                                sorted,
+                                guaranteed,
+                            );
+                        } else {
+                            counts[3] += 1;
+                            scratch.polygon.whole(&frame, ps);
+                        }
+                        if let Outcome::NeedMore(r2) = outcome {
+                            counts[1] += 1;
+                            outcome = self.clip_wide(s, ps, &frame, r2, scratch);
+                        }
+                        if outcome != Outcome::Done {
+                            continue;
+                        }
+                        let (a, c) = scratch.polygon.moment();
+                        area += a;
+                        first += (frame.point(c.x, c.y) - ps) * a;
+                        let mut flag = if a > 0.0 { TOUCHED } else { 0 };
+                        if !self.leads_to_processing(&scratch.polygon, tri, self.reach2) {
+                            flag |= INCOMPLETE;
+                        }
+                        if flag != 0 {
+                            flags[t as usize].fetch_or(flag, Ordering::Relaxed);
+                        }
                     }
                 }
             }
@@ -641,26 +648,32 @@ impl Pass<'_> {
                 cells.sites_of(c).map(move |s| {
                     let p = sums[s].1.as_dvec3();
                     let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0], p);
-                    for (patch, [lo, hi]) in cells.patches_of(c) {
+                    for (run, [lo, hi]) in cells.patch_runs(c) {
                         // Not nearer than the best so far (a tie keeps the first): skipped.
                         if box_distance2_below_all(p, *lo, *hi) >= best.0 {
                             continue;
                         }
-                        for t in patch {
-                            if !self.live[t as usize] {
+                        for &q in run {
+                            let (patch, [lo, hi]) = cells.patch(q as usize);
+                            if patch.len() > 1 && box_distance2_below_all(p, *lo, *hi) >= best.0 {
                                 continue;
                             }
-                            let tri = &self.triangles[t as usize];
-                            if box_distance2_below(p, tri) >= best.0 {
-                                continue;
-                            }
-                            let w = nearest_on_triangle(p, tri);
-                            let q = tri[0].as_dvec3() * w[0]
-                                + tri[1].as_dvec3() * w[1]
-                                + tri[2].as_dvec3() * w[2];
-                            let d2 = p.distance_squared(q);
-                            if d2 < best.0 {
-                                best = (d2, t, w, q);
+                            for t in patch {
+                                if !self.live[t as usize] {
+                                    continue;
+                                }
+                                let tri = &self.triangles[t as usize];
+                                if box_distance2_below(p, tri) >= best.0 {
+                                    continue;
+                                }
+                                let w = nearest_on_triangle(p, tri);
+                                let q = tri[0].as_dvec3() * w[0]
+                                    + tri[1].as_dvec3() * w[1]
+                                    + tri[2].as_dvec3() * w[2];
+                                let d2 = p.distance_squared(q);
+                                if d2 < best.0 {
+                                    best = (d2, t, w, q);
+                                }
                             }
                         }
                     }
