@@ -255,6 +255,9 @@ fn areas_of_cells(
 /// is 0).
 type CellSum = (f32, Vec3);
 
+/// The nearest point found so far: its squared distance, triangle, barycentrics and position.
+type Best = (f64, u32, [f64; 3], DVec3);
+
 /// A polygon the redo pass found for a site the first pass skipped.
 struct Piece {
     site: u32,
@@ -639,7 +642,7 @@ impl Pass<'_> {
 
     /// Each sorted site's centroid moved to the nearest point of the triangles with area in
     /// the patches registered to its grid cell (which hold every triangle within the reach of
-    /// its sites), ties to the first; in sorted order.
+    /// its sites), ties to the lowest triangle index; in sorted order.
     fn centroids_on_surface(&self, sums: &[CellSum]) -> Vec<SurfacePoint> {
         let cells = self.cells;
         (0..cells.len())
@@ -648,33 +651,51 @@ impl Pass<'_> {
                 cells.sites_of(c).map(move |s| {
                     let p = sums[s].1.as_dvec3();
                     let mut best = (f64::INFINITY, u32::MAX, [1.0, 0.0, 0.0], p);
-                    for (run, [lo, hi]) in cells.patch_runs(c) {
-                        // Not nearer than the best so far (a tie keeps the first): skipped.
-                        if box_distance2_below_all(p, *lo, *hi) >= best.0 {
+                    // The nearest of a patch's triangles to `p`, if nearer than `best` or as
+                    // near with a lower index; a box farther than `best` is skipped.
+                    let visit = |patch: std::ops::Range<u32>, best: &mut Best| {
+                        for t in patch {
+                            if !self.live[t as usize] {
+                                continue;
+                            }
+                            let tri = &self.triangles[t as usize];
+                            if box_distance2_below(p, tri) > best.0 {
+                                continue;
+                            }
+                            let w = nearest_on_triangle(p, tri);
+                            let q = tri[0].as_dvec3() * w[0]
+                                + tri[1].as_dvec3() * w[1]
+                                + tri[2].as_dvec3() * w[2];
+                            let d2 = p.distance_squared(q);
+                            if d2 < best.0 || (d2 == best.0 && t < best.1) {
+                                *best = (d2, t, w, q);
+                            }
+                        }
+                    };
+                    // First the patch whose box is nearest, in the run whose box is: its
+                    // distance then skips nearly every other patch.
+                    let box_to = |[lo, hi]: &[Vec3; 2]| box_distance2_below_all(p, *lo, *hi);
+                    let nearest_run = cells
+                        .patch_runs(c)
+                        .min_by(|a, b| box_to(a.1).total_cmp(&box_to(b.1)));
+                    if let Some((run, _)) = nearest_run {
+                        let patches = run.iter().map(|&q| cells.patch(q as usize));
+                        if let Some((patch, _)) =
+                            patches.min_by(|a, b| box_to(a.1).total_cmp(&box_to(b.1)))
+                        {
+                            visit(patch, &mut best);
+                        }
+                    }
+                    for (run, bounds) in cells.patch_runs(c) {
+                        if box_to(bounds) > best.0 {
                             continue;
                         }
                         for &q in run {
-                            let (patch, [lo, hi]) = cells.patch(q as usize);
-                            if patch.len() > 1 && box_distance2_below_all(p, *lo, *hi) >= best.0 {
+                            let (patch, bounds) = cells.patch(q as usize);
+                            if patch.len() > 1 && box_to(bounds) > best.0 {
                                 continue;
                             }
-                            for t in patch {
-                                if !self.live[t as usize] {
-                                    continue;
-                                }
-                                let tri = &self.triangles[t as usize];
-                                if box_distance2_below(p, tri) >= best.0 {
-                                    continue;
-                                }
-                                let w = nearest_on_triangle(p, tri);
-                                let q = tri[0].as_dvec3() * w[0]
-                                    + tri[1].as_dvec3() * w[1]
-                                    + tri[2].as_dvec3() * w[2];
-                                let d2 = p.distance_squared(q);
-                                if d2 < best.0 {
-                                    best = (d2, t, w, q);
-                                }
-                            }
+                            visit(patch, &mut best);
                         }
                     }
                     match best {
