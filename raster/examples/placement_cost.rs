@@ -8,6 +8,9 @@
 //!
 //! Arguments: the scene, the sample count, the number of runs (medians are printed, with each
 //! run's figures). CPU time is the process's user + system time over all threads.
+//!
+//! Each run also prints a hash of the samples' positions and one of their cells' areas and
+//! centroids: a change meant to keep the output must keep both.
 
 use std::path::Path;
 use std::time::Instant;

@@ -328,7 +328,6 @@ impl Cells {
             boxes.extend(b);
         }
         starts.push(triangles.len() as u32);
-        let (starts, boxes) = (starts, boxes);
         // Per chunk of patches, their cells one after the other and how many each has: no
         // allocation per patch (a list each took a quarter of the pass on 2 M triangles).
         let chunks: Vec<(Vec<u32>, Vec<u32>)> = boxes

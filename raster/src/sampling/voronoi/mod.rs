@@ -61,9 +61,9 @@
 //! neighbour sort); at most 33 bytes per sample of transient memory (`cells.rs`: positions,
 //! order and cells about 20, the areas 4, 4 per (cell, patch) pair; the grid's sort peaks at
 //! 20), 4 bytes per triangle for the owners, and about 2 per triangle for the patches of a mesh
-//! finer than the samples (28 per patch of up to 16 triangles). On a mesh finer than the samples most
-//! triangles have an owner: on a 2 M-triangle sphere with 23 000 samples the areas take a
-//! fifth less time than clipping every pair. Measured with the `voronoi_cost` example;
+//! finer than the samples (28 per patch of up to 16 triangles). On such a mesh most triangles
+//! have an owner: on a 2 M-triangle sphere with 23 000 samples the areas take a fifth less
+//! time than clipping every pair. Measured with the `voronoi_cost` example;
 //! figures in `BENCHMARKS.md`.
 //!
 //! # Accuracy

@@ -48,8 +48,9 @@ const SLACK: f64 = 0.25;
 /// the triangles' patches ([`Cells::register_triangles`]).
 ///
 /// The triangles of a patch of several are searched among the patch's candidates
-/// ([`Block::search_patch`]); a triangle alone in its patch, as large as a cell or more, among
-/// all the sites of the block of cells around its first corner ([`Block::search_block`]).
+/// ([`Block::search_patch`]); a triangle alone in its patch (larger than a quarter of a cell,
+/// or beside one) among all the sites of the block of cells around its first corner
+/// ([`Block::search_block`]).
 pub(super) fn triangle_owners(
     cells: &Cells,
     triangles: &[[Vec3; 3]],
@@ -120,7 +121,8 @@ struct Nearest {
 }
 
 impl Block {
-    /// Gathers the sites of the block of cells around `home` unless it is the last one.
+    /// Gathers the sites of the block of cells around `home`, unless they are those of the last
+    /// block; returns whether it did.
     fn gather(&mut self, cells: &Cells, home: [i64; 3]) -> bool {
         if self.home == Some(home) {
             return false;
