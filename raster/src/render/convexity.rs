@@ -136,16 +136,18 @@ fn cannot_shadow_itself_within(mesh: &Mesh, limit: u64, sketch: usize) -> (bool,
     let count = faces.with_plane.len();
     if count > 4 * PROBE_FACES {
         stride = count / PROBE_FACES;
-        let mut probed = 0u64;
-        for &face in faces.with_plane.iter().step_by(stride) {
-            let (passed, visits) = tree.nothing_in_front(&faces.plane(face), tolerance, margin);
-            probe_visits += visits;
-            probed += 1;
-            if !passed {
-                return (false, probe_visits);
-            }
-        }
-        let estimate = probe_visits as f64 / probed as f64 * count as f64;
+        let planes = faces.with_plane.iter().step_by(stride);
+        let (estimate, visits) = match probe(
+            &tree,
+            planes.map(|&face| faces.plane(face)),
+            count,
+            tolerance,
+            margin,
+        ) {
+            Ok(probed) => probed,
+            Err(visits) => return (false, visits),
+        };
+        probe_visits = visits;
         if estimate > PROBE_MARGIN * limit as f64 {
             return (false, probe_visits);
         }
@@ -218,19 +220,32 @@ fn sketched_work(mesh: &Mesh, origin: DVec3, diagonal: f64, sketch: usize) -> Op
         MARGIN * diagonal,
         DEGENERATE * diagonal,
     );
+    let planes = (0..count as u32)
+        .step_by((count / PROBE_FACES).max(1))
+        .filter_map(|face| plane_of(mesh, origin, apart, face));
+    probe(&tree, planes, count, tolerance, margin).ok()
+}
+
+/// Tests the faces of `planes` against `tree` and extrapolates their visits to `count` faces:
+/// the estimate and the visits made, or, if a face has a vertex in front of it, the visits
+/// made up to it.
+fn probe(
+    tree: &VertexTree,
+    planes: impl Iterator<Item = Plane>,
+    count: usize,
+    tolerance: f64,
+    margin: f64,
+) -> Result<(f64, u64), u64> {
     let (mut visits, mut probed) = (0u64, 0u64);
-    for face in (0..count as u32).step_by((count / PROBE_FACES).max(1)) {
-        let Some(plane) = plane_of(mesh, origin, apart, face) else {
-            continue;
-        };
+    for plane in planes {
         let (passed, v) = tree.nothing_in_front(&plane, tolerance, margin);
         visits += v;
         probed += 1;
         if !passed {
-            return None;
+            return Err(visits);
         }
     }
-    Some((visits as f64 / probed.max(1) as f64 * count as f64, visits))
+    Ok((visits as f64 / probed.max(1) as f64 * count as f64, visits))
 }
 
 /// The smallest corner of the positions' bounding box and its diagonal's length, in f64 (the

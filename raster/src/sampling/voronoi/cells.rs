@@ -346,9 +346,13 @@ impl Cells {
                         (Some(t), None) => {
                             self.cells_near(&triangles[t], reach, &mut own, &mut stack)
                         }
-                        (Some(_), Some(_)) => {
-                            self.cells_near_box(lo.as_dvec3(), hi.as_dvec3(), reach, &mut own)
-                        }
+                        (Some(_), Some(_)) => self.cells_in_box(
+                            lo.as_dvec3(),
+                            hi.as_dvec3(),
+                            reach,
+                            |_| true,
+                            &mut own,
+                        ),
                     }
                     own.sort_unstable();
                     own.dedup();
@@ -442,12 +446,25 @@ impl Cells {
         (self.cell_start[first], self.cell_start[end])
     }
 
-    /// The occupied cells that the box `lo..hi`, grown by `reach`, overlaps.
-    fn cells_near_box(&self, lo: DVec3, hi: DVec3, reach: f64, out: &mut Vec<u32>) {
+    /// The occupied cells that the box `lo..hi`, grown by `reach`, overlaps and whose centre
+    /// `keep` accepts.
+    fn cells_in_box(
+        &self,
+        lo: DVec3,
+        hi: DVec3,
+        reach: f64,
+        keep: impl Fn(DVec3) -> bool,
+        out: &mut Vec<u32>,
+    ) {
         let (a, b) = (self.coords(lo - reach), self.coords(hi + reach));
         for x in a[0]..=b[0] {
             for y in a[1]..=b[1] {
                 for z in a[2]..=b[2] {
+                    let centre =
+                        self.origin + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.size;
+                    if !keep(centre) {
+                        continue;
+                    }
                     if let Some(c) = self.find([x, y, z]) {
                         out.push(c as u32);
                     }
@@ -484,23 +501,10 @@ impl Cells {
             // Only cells within `reach` of the piece's plane can hold a site within `reach`.
             let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
             let half_diagonal = 0.5 * 3f64.sqrt() * self.size;
-            let (a, b) = (self.coords(lo - reach), self.coords(hi + reach));
-            for x in a[0]..=b[0] {
-                for y in a[1]..=b[1] {
-                    for z in a[2]..=b[2] {
-                        if normal != DVec3::ZERO {
-                            let centre = self.origin
-                                + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.size;
-                            if (centre - p[0]).dot(normal).abs() > reach + half_diagonal {
-                                continue;
-                            }
-                        }
-                        if let Some(c) = self.find([x, y, z]) {
-                            out.push(c as u32);
-                        }
-                    }
-                }
-            }
+            let near_plane = |centre: DVec3| {
+                normal == DVec3::ZERO || (centre - p[0]).dot(normal).abs() <= reach + half_diagonal
+            };
+            self.cells_in_box(lo, hi, reach, near_plane, out);
         }
     }
 }
