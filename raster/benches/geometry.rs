@@ -13,7 +13,7 @@ use divan::counter::ItemsCount;
 use divan::{Bencher, black_box};
 use glam::Vec3;
 use lucent_raster::geometry::shapes::{grid, icosphere};
-use lucent_raster::geometry::{Bvh, ShadowHint, offset_origin};
+use lucent_raster::geometry::{Bvh, CLUSTER, ShadowHint, offset_origin};
 use lucent_raster::sampling::rng::Pcg32;
 use lucent_raster::sampling::{SampleTarget, poisson_samples};
 use lucent_raster::scene::Mesh;
@@ -115,18 +115,23 @@ fn coherent_shadow_rays(tris: &[[Vec3; 3]], n_sphere: usize, bvh: &Bvh) -> Vec<(
     rays
 }
 
-#[divan::bench(sample_count = 20)]
-fn bvh_build(bencher: Bencher) {
+/// The argument of the random-ray benches: how many triangles a cluster holds at most (1: the
+/// tree over single triangles that scenes below `CLUSTERED_FROM` get; `CLUSTER`: the one of
+/// larger scenes, built here over the same triangles to compare).
+const CLUSTERS: [usize; 2] = [1, CLUSTER];
+
+#[divan::bench(args = CLUSTERS, sample_count = 20)]
+fn bvh_build(bencher: Bencher, cluster: usize) {
     let tris = scene();
     bencher
         .counter(ItemsCount::new(tris.len()))
-        .bench(|| Bvh::build(black_box(&tris)));
+        .bench(|| Bvh::try_build_clustered(black_box(&tris), cluster).unwrap());
 }
 
-#[divan::bench(sample_count = 20)]
-fn occluded(bencher: Bencher) {
+#[divan::bench(args = CLUSTERS, sample_count = 20)]
+fn occluded(bencher: Bencher, cluster: usize) {
     let tris = scene();
-    let bvh = Bvh::build(&tris);
+    let bvh = Bvh::try_build_clustered(&tris, cluster).unwrap();
     let rays = shadow_rays(&tris, &bvh, 100_000);
     bencher.counter(ItemsCount::new(rays.len())).bench(|| {
         rays.iter()
@@ -135,10 +140,10 @@ fn occluded(bencher: Bencher) {
     });
 }
 
-#[divan::bench(sample_count = 20)]
-fn intersect(bencher: Bencher) {
+#[divan::bench(args = CLUSTERS, sample_count = 20)]
+fn intersect(bencher: Bencher, cluster: usize) {
     let tris = scene();
-    let bvh = Bvh::build(&tris);
+    let bvh = Bvh::try_build_clustered(&tris, cluster).unwrap();
     let rays = shadow_rays(&tris, &bvh, 100_000);
     bencher.counter(ItemsCount::new(rays.len())).bench(|| {
         rays.iter()

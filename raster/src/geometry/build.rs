@@ -4,10 +4,18 @@
 //! Every node bins its triangles' centroids into [`BINS`] equal slabs along each axis (a node
 //! of more than [`BINNED`] triangles, a regular sample of them), sweeps the bins to price every
 //! split plane with the surface area heuristic, and either splits at the cheapest plane or
-//! becomes a leaf when that is cheaper (and it holds at most [`MAX_LEAF`] triangles). Each level is O(N), so the build is O(N log N) for the usual balanced splits; to
-//! bound the depth (and so the fixed traversal stack) for any input, nodes deeper than
-//! [`MEDIAN_DEPTH`] switch to object-median splits, which halve the count, so no path is longer
-//! than `MEDIAN_DEPTH + 31` for fewer than 2³¹ triangles.
+//! becomes a leaf when that is cheaper (and it holds at most [`MAX_LEAF`] triangles). Each
+//! level is O(N), so the build is O(N log N) for the usual balanced splits; to bound the depth
+//! (and so the fixed traversal stack) for any input, nodes deeper than [`MEDIAN_DEPTH`] switch
+//! to object-median splits, which halve the count, so no path is longer than
+//! `MEDIAN_DEPTH + 31` for fewer than 2³¹ triangles.
+//!
+//! Scenes of millions of triangles are built over *clusters* instead of single triangles
+//! (`cluster.rs`): runs of up to [`CLUSTER`](super::CLUSTER) consecutive triangles whose boxes
+//! touch and are of about one size (a strip of a scanned or tessellated mesh), each priced by
+//! the SAH as its triangles and kept whole in one leaf. The build then handles a quarter of the
+//! items at every level; rays pay for leaves of whole clusters (see
+//! [`CLUSTERED_FROM`](super::CLUSTERED_FROM)).
 //!
 //! Free of hashing or randomness, so the tree is a pure function of the input: large subtrees
 //! are built on two threads and spliced where a one-threaded build puts them, so the node
@@ -21,6 +29,7 @@ use rayon::prelude::*;
 use crate::memory::{self, OutOfMemory};
 
 use super::aabb::Aabb;
+use super::cluster::Clusters;
 use super::node::{BvhNode, WideNode};
 
 /// Centroid bins per axis. Wald 2007 found 16–32 bins within a few percent of a full sweep.
@@ -75,20 +84,20 @@ pub(super) const PARALLEL_MIN: usize = 1 << 14;
 /// the same to the bit. 32 bytes, half a cache line; the centroid is computed from it rather
 /// than read from an array of its own.
 #[derive(Clone, Copy)]
-struct Bounds {
-    min: Vec3A,
-    max: Vec3A,
+pub(super) struct Bounds {
+    pub(super) min: Vec3A,
+    pub(super) max: Vec3A,
 }
 
 const _: () = assert!(core::mem::size_of::<Bounds>() == 32);
 
 impl Bounds {
-    const EMPTY: Bounds = Bounds {
+    pub(super) const EMPTY: Bounds = Bounds {
         min: Vec3A::splat(f32::INFINITY),
         max: Vec3A::splat(f32::NEG_INFINITY),
     };
 
-    fn of(b: &Aabb) -> Bounds {
+    pub(super) fn of(b: &Aabb) -> Bounds {
         Bounds {
             min: b.min.into(),
             max: b.max.into(),
@@ -103,7 +112,7 @@ impl Bounds {
     }
 
     #[inline(always)]
-    fn union(self, o: Bounds) -> Bounds {
+    pub(super) fn union(self, o: Bounds) -> Bounds {
         Bounds {
             min: self.min.min(o.min),
             max: self.max.max(o.max),
@@ -114,6 +123,18 @@ impl Bounds {
     fn grow(&mut self, p: Vec3A) {
         self.min = self.min.min(p);
         self.max = self.max.max(p);
+    }
+
+    /// The length of the box's diagonal.
+    #[inline(always)]
+    pub(super) fn diagonal(self) -> f32 {
+        (self.max - self.min).length()
+    }
+
+    /// True when the two boxes share a point (closed boxes).
+    #[inline(always)]
+    pub(super) fn touches(self, o: Bounds) -> bool {
+        o.min.cmple(self.max).all() && self.min.cmple(o.max).all()
     }
 
     /// [`Aabb::center`].
@@ -155,15 +176,18 @@ enum Piece {
 }
 
 /// Builds the tree over `triangles` (only the first [`MAX_TRIANGLES`] are looked at), building
-/// subtrees of at least `parallel_min` triangles on two threads and pricing the planes of a
-/// node of more than `binned` triangles from about `binned` of them. The nodes are the same
-/// for every `parallel_min` (the one-threaded build's), so that tests can compare a build split
-/// into many pieces with one that is not split at all. The renderer passes [`PARALLEL_MIN`]
-/// and [`BINNED`]; tests lower `binned` so that small inputs take the sampled path too.
+/// subtrees of at least `parallel_min` items on two threads, pricing the planes of a node of
+/// more than `binned` items from about `binned` of them, and over clusters of up to
+/// `cluster` triangles (1: every triangle on its own). The nodes are the same for every
+/// `parallel_min` (the one-threaded build's), so that tests can compare a build split into
+/// many pieces with one that is not split at all. The renderer passes [`PARALLEL_MIN`],
+/// [`BINNED`] and [`super::cluster::cluster_size`]; tests lower `binned` so that small inputs
+/// take the sampled path too, and cluster small inputs.
 pub(super) fn build_with(
     triangles: &[[Vec3; 3]],
     parallel_min: usize,
     binned: usize,
+    cluster: usize,
 ) -> Result<Built, OutOfMemory> {
     let triangles = &triangles[..triangles.len().min(MAX_TRIANGLES)];
     let boxes = memory::par_collect(
@@ -188,19 +212,43 @@ pub(super) fn build_with(
             skipped,
         });
     }
-    let builder = Builder {
-        boxes: &boxes,
-        binned: binned.max(1),
+    let (parallel_min, binned) = (parallel_min.max(2), binned.max(1));
+    // A mesh in no particular order would give clusters of one, which only add their
+    // bookkeeping to the plain build.
+    let clusters = if cluster > 1 && Clusters::worthwhile(&order, &boxes) {
+        Some(Clusters::of(
+            &order,
+            &boxes,
+            cluster.min(MAX_LEAF as usize),
+        )?)
+    } else {
+        None
     };
-    let nodes = match builder.piece(&mut order, 0, 0, parallel_min.max(2))? {
-        Piece::Whole(nodes) => nodes,
-        split => {
-            let mut nodes = memory::with_capacity(2 * order.len() - 1, memory::TRIANGLES)?;
-            nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
-            place(split, 0, &mut nodes);
-            nodes
-        }
+    let Some(clusters) = clusters else {
+        let builder = Builder::<false> {
+            boxes: &boxes,
+            weights: &[],
+            binned,
+        };
+        let nodes = builder.tree(&mut order, parallel_min)?;
+        return Ok(Built {
+            nodes,
+            order,
+            skipped,
+        });
     };
+    drop(boxes);
+    let mut items = memory::par_collect(
+        (0..clusters.len() as u32).into_par_iter(),
+        memory::TRIANGLES,
+    )?;
+    let builder = Builder::<true> {
+        boxes: &clusters.boxes,
+        weights: &clusters.size,
+        binned,
+    };
+    let mut nodes = builder.tree(&mut items, parallel_min)?;
+    let order = clusters.expand(&items, &order, &mut nodes)?;
     Ok(Built {
         nodes,
         order,
@@ -245,9 +293,14 @@ fn shifted(mut node: BvhNode, shift: u32) -> BvhNode {
 /// through the partitions instead of indices into separate arrays: no gain on 2 M triangles. And
 /// a split's parts given their bounds from its bins and partition instead of a pass over each:
 /// no gain on 100 k or 5 M triangles.)
-struct Builder<'a> {
+///
+/// An item is a triangle, or with `CLUSTERED` a cluster whose triangles are counted by
+/// `weights` (see [`Clusters`]): the SAH counts triangles either way.
+struct Builder<'a, const CLUSTERED: bool> {
     boxes: &'a [Bounds],
-    /// About how many triangles price a node's planes (see [`BINNED`]).
+    /// Triangles per item (empty when not `CLUSTERED`: one each).
+    weights: &'a [u8],
+    /// About how many items price a node's planes (see [`BINNED`]).
     binned: usize,
 }
 
@@ -259,7 +312,30 @@ struct Split {
     cost: f32,
 }
 
-impl Builder<'_> {
+impl<const CLUSTERED: bool> Builder<'_, CLUSTERED> {
+    /// The tree over `items`, root first.
+    fn tree(&self, items: &mut [u32], parallel_min: usize) -> Result<Vec<BvhNode>, OutOfMemory> {
+        Ok(match self.piece(items, 0, 0, parallel_min)? {
+            Piece::Whole(nodes) => nodes,
+            split => {
+                let mut nodes = memory::with_capacity(2 * items.len() - 1, memory::TRIANGLES)?;
+                nodes.push(BvhNode::new(&Aabb::EMPTY, 0, 0));
+                place(split, 0, &mut nodes);
+                nodes
+            }
+        })
+    }
+
+    /// Triangles in item `i`.
+    #[inline(always)]
+    fn weight(&self, i: u32) -> u32 {
+        if CLUSTERED {
+            u32::from(self.weights[i as usize])
+        } else {
+            1
+        }
+    }
+
     /// The subtree over `items` (the slots from `offset` on of the leaf order, at `depth`),
     /// its halves built on two threads while it holds at least `parallel_min` triangles.
     fn piece(
@@ -272,8 +348,8 @@ impl Builder<'_> {
         if items.len() < parallel_min {
             return self.whole(items, offset, depth).map(Piece::Whole);
         }
-        let (bounds, cbounds) = self.bounds(items);
-        let Some(mid) = self.choose_split(items, &bounds, &cbounds, depth) else {
+        let (bounds, cbounds, triangles) = self.bounds(items);
+        let Some(mid) = self.choose_split(items, &bounds, &cbounds, depth, triangles) else {
             let leaf = BvhNode::new(&bounds.to_aabb(), offset, items.len() as u32);
             return Ok(Piece::Whole(vec![leaf]));
         };
@@ -306,9 +382,9 @@ impl Builder<'_> {
         }];
         while let Some(task) = stack.pop() {
             let items = &mut items[task.start as usize..task.end as usize];
-            let (bounds, cbounds) = self.bounds(items);
+            let (bounds, cbounds, triangles) = self.bounds(items);
             let n = items.len() as u32;
-            let mid = match self.choose_split(items, &bounds, &cbounds, task.depth) {
+            let mid = match self.choose_split(items, &bounds, &cbounds, task.depth, triangles) {
                 None => {
                     let bounds = bounds.to_aabb();
                     nodes[task.node as usize] = BvhNode::new(&bounds, offset + task.start, n);
@@ -337,15 +413,16 @@ impl Builder<'_> {
         Ok(nodes)
     }
 
-    /// Bounds of the triangles and of their centroids.
-    fn bounds(&self, items: &[u32]) -> (Bounds, Bounds) {
-        let (mut b, mut c) = (Bounds::EMPTY, Bounds::EMPTY);
+    /// Bounds of the items and of their centroids, and how many triangles they hold.
+    fn bounds(&self, items: &[u32]) -> (Bounds, Bounds, u32) {
+        let (mut b, mut c, mut triangles) = (Bounds::EMPTY, Bounds::EMPTY, 0);
         for &i in items {
             let own = self.boxes[i as usize];
             b = b.union(own);
             c.grow(own.center());
+            triangles += self.weight(i);
         }
-        (b, c)
+        (b, c, triangles)
     }
 
     /// The centroid of triangle `i`'s box.
@@ -354,14 +431,15 @@ impl Builder<'_> {
         self.boxes[i as usize].center()
     }
 
-    /// Partitions `items` for a split and returns the size of the left part, or `None` to make
-    /// a leaf.
+    /// Partitions `items` (holding `triangles`) for a split and returns the size of the left
+    /// part, or `None` to make a leaf.
     fn choose_split(
         &self,
         items: &mut [u32],
         bounds: &Bounds,
         cb: &Bounds,
         depth: u32,
+        triangles: u32,
     ) -> Option<u32> {
         let n = items.len() as u32;
         if n <= 1 {
@@ -377,10 +455,10 @@ impl Builder<'_> {
         };
         if extent[axis].is_nan() || extent[axis] <= 0.0 {
             // All centroids coincide: no plane separates them. Split by position in the list.
-            return (n > MAX_LEAF).then_some(n / 2);
+            return (triangles > MAX_LEAF).then_some(n / 2);
         }
         if depth >= MEDIAN_DEPTH {
-            if n <= MAX_LEAF {
+            if triangles <= MAX_LEAF {
                 return None;
             }
             let key = |&i: &u32| (self.centroid(i)[axis], i);
@@ -398,12 +476,12 @@ impl Builder<'_> {
             },
         );
         let Some(best) = best else {
-            return (n > MAX_LEAF).then_some(n / 2);
+            return (triangles > MAX_LEAF).then_some(n / 2);
         };
         let parent_area = bounds.half_area();
-        let leaf_cost = parent_area * n as f32;
+        let leaf_cost = parent_area * triangles as f32;
         let split_cost = TRAVERSAL_COST * parent_area + best.cost;
-        if n <= MAX_LEAF && split_cost >= leaf_cost {
+        if triangles <= MAX_LEAF && split_cost >= leaf_cost {
             return None;
         }
         let scale = BINS as f32 / extent[best.axis];
@@ -448,7 +526,7 @@ impl Builder<'_> {
             for a in 0..3 {
                 if spread[a] {
                     let k = bin_of(c[a], cb.min[a], scale[a]);
-                    counts[a][k] += 1;
+                    counts[a][k] += self.weight(i);
                     boxes[a][k] = boxes[a][k].union(b);
                 }
             }
@@ -655,7 +733,7 @@ mod tests {
             }
             let key = |s: Option<Split>| s.map(|s| (s.axis, s.bin, s.cost.to_bits()));
             let (new, old) = (
-                key(Builder::cheapest_plane(&counts, &boxes, 1)),
+                key(Builder::<false>::cheapest_plane(&counts, &boxes, 1)),
                 key(every_bin_cheapest_plane(&counts, &boxes, 1)),
             );
             assert_eq!(new, old, "{counts:?}");

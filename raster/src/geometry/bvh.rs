@@ -134,21 +134,40 @@ impl Bvh {
     }
 
     /// [`Bvh::build`], or [`OutOfMemory`] if the allocator refuses one of its buffers.
+    ///
+    /// From [`CLUSTERED_FROM`](super::CLUSTERED_FROM) triangles on, the tree is built over
+    /// clusters of up to [`CLUSTER`](super::CLUSTER) consecutive triangles (see
+    /// [`Bvh::try_build_clustered`]).
     pub fn try_build(triangles: &[[Vec3; 3]]) -> Result<Bvh, OutOfMemory> {
-        Self::try_build_binning(triangles, build::BINNED)
+        let cluster = super::cluster::cluster_size(triangles.len().min(MAX_TRIANGLES));
+        Self::try_build_with(triangles, build::BINNED, cluster)
     }
 
-    /// [`Bvh::try_build`], a node's planes priced from about `binned` of its triangles (tests
-    /// set it low, so that small inputs take the sampled path too).
-    pub(super) fn try_build_binning(
+    /// [`Bvh::try_build`] over clusters of up to `cluster` consecutive triangles whose boxes
+    /// touch, whatever the number of triangles (1: every triangle on its own; more than a
+    /// leaf's eight is taken as eight). Clusters make the build about three times cheaper and
+    /// rays 9–12% dearer: worth it where the triangles far outnumber the rays the tree will
+    /// answer. Queries give the same answers either way. Triangles in no particular order
+    /// (fewer than half touching the one before) are built one by one all the same.
+    pub fn try_build_clustered(
+        triangles: &[[Vec3; 3]],
+        cluster: usize,
+    ) -> Result<Bvh, OutOfMemory> {
+        Self::try_build_with(triangles, build::BINNED, cluster)
+    }
+
+    /// [`Bvh::try_build_clustered`], a node's planes priced from about `binned` of its items
+    /// (tests set it low, so that small inputs take the sampled path too).
+    pub(super) fn try_build_with(
         triangles: &[[Vec3; 3]],
         binned: usize,
+        cluster: usize,
     ) -> Result<Bvh, OutOfMemory> {
         let build::Built {
             nodes,
             order,
             skipped,
-        } = build::build_with(triangles, build::PARALLEL_MIN, binned)?;
+        } = build::build_with(triangles, build::PARALLEL_MIN, binned, cluster)?;
         // The binary tree is collapsed and freed before the triangles are copied, so that the
         // two are never held at once (this is where the preparation's memory peaks).
         let wide = build::collapse(&nodes)?;

@@ -18,12 +18,14 @@
 //! | `ray.rs` | prepared rays, the watertight triangle test, hits, origin offset |
 //! | `node.rs` | the 32-byte binary node and the 128-byte 4-wide node |
 //! | `build.rs` | binned SAH construction, collapse to the 4-wide tree |
+//! | `cluster.rs` | runs of touching triangles built as one item (scenes of millions) |
 //! | `bvh.rs` | the BVH, its queries and `validate` |
 //! | `shapes.rs` | procedural meshes for tests and benchmarks |
 
 mod aabb;
 mod build;
 mod bvh;
+mod cluster;
 mod node;
 mod ray;
 pub mod shapes;
@@ -31,6 +33,7 @@ pub mod shapes;
 pub use aabb::Aabb;
 pub(crate) use aabb::vertex_bounds;
 pub use bvh::{Bvh, InvariantError, ShadowHint};
+pub use cluster::{CLUSTER, CLUSTERED_FROM};
 pub use node::WideNode;
 pub use ray::{Hit, OFFSET_RELATIVE, Ray, offset_origin};
 
