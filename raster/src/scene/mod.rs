@@ -35,6 +35,7 @@ pub mod ply;
 pub mod sanity;
 mod settings;
 pub mod shapes;
+mod spatial_order;
 mod tables;
 pub mod weld;
 

@@ -60,7 +60,9 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// Texture coordinates, one per vertex, if the mesh has them.
     pub uvs: Option<Vec<Vec2>>,
-    /// Counter-clockwise triangles (seen from outside), as vertex indices.
+    /// Counter-clockwise triangles (seen from outside), as vertex indices: in the file's order,
+    /// except that the loader puts a large mesh listed in no particular order in Z-order
+    /// (`docs/scene-format.md`, "Mesh files").
     pub triangles: Vec<[u32; 3]>,
 }
 

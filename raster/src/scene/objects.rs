@@ -22,6 +22,7 @@ use super::sanity::{
     PositionIds, drop_coincident_triangles, normals_against_winding, orient_outward,
 };
 use super::shapes::{self, DEFAULT_SEGMENTS, MAX_SEGMENTS, MIN_SEGMENTS};
+use super::spatial_order::order_spatially;
 use super::weld::{MAX_CREASE_DEGREES, weld_normals};
 
 /// Values accepted by `shape`.
@@ -221,7 +222,7 @@ pub(crate) fn build_object(
         Some(n) => n.get_ref().clone(),
         None => default_name,
     };
-    split_by_material(
+    let mut objects = split_by_material(
         c,
         index,
         o,
@@ -232,7 +233,11 @@ pub(crate) fn build_object(
         table,
         origin,
         &source,
-    )
+    )?;
+    for object in &mut objects {
+        order_spatially(&mut object.mesh);
+    }
+    Ok(objects)
 }
 
 /// The crease angle to weld with, if `weld = true` or `crease_angle` ask for smooth normals
