@@ -31,13 +31,7 @@ pub(crate) fn order_spatially(mesh: &mut Mesh) -> bool {
         return false;
     }
     let corners = |t: &[u32; 3]| t.map(|i| mesh.positions[i as usize]);
-    let (lo, hi) = mesh
-        .positions
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
-    let grid = Grid::new(lo, hi);
+    let grid = grid_over(&mesh.positions);
     // The index is part of every key, so the keys are distinct and the unstable sort gives
     // one order for any number of threads.
     let mut keys: Vec<(u64, u32)> = mesh
@@ -55,6 +49,16 @@ pub(crate) fn order_spatially(mesh: &mut Mesh) -> bool {
         .map(|&(_, i)| mesh.triangles[i as usize])
         .collect();
     true
+}
+
+/// The Morton grid over the box of `positions`.
+fn grid_over(positions: &[Vec3]) -> Grid {
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    Grid::new(lo, hi)
 }
 
 /// True when at least half of the mesh's triangles touch the one before them (their boxes
@@ -111,13 +115,7 @@ mod tests {
         b.sort_unstable();
         assert_eq!(a, b);
         assert!(in_strips(&mesh));
-        let (lo, hi) = ordered
-            .positions
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-                (lo.min(p), hi.max(p))
-            });
-        let grid = Grid::new(lo, hi);
+        let grid = grid_over(&ordered.positions);
         let positions = ordered.positions.clone();
         let code = |t: &[u32; 3]| {
             let [a, b, c] = t.map(|i| positions[i as usize]);
