@@ -337,7 +337,7 @@ impl<const CLUSTERED: bool> Builder<'_, CLUSTERED> {
     }
 
     /// The subtree over `items` (the slots from `offset` on of the leaf order, at `depth`),
-    /// its halves built on two threads while it holds at least `parallel_min` triangles.
+    /// its halves built on two threads while it holds at least `parallel_min` items.
     fn piece(
         &self,
         items: &mut [u32],
