@@ -77,10 +77,24 @@ impl Aabb {
         other.is_empty() || (self.min.cmple(other.min).all() && other.max.cmple(self.max).all())
     }
 
+    /// True if the two boxes share a point (closed boxes; never for an empty one).
+    pub fn touches(&self, other: &Aabb) -> bool {
+        other.min.cmple(self.max).all() && self.min.cmple(other.max).all()
+    }
+
     /// True if every coordinate is finite.
     pub fn is_finite(&self) -> bool {
         self.min.is_finite() && self.max.is_finite()
     }
+}
+
+/// True when at least half of `items` touch the one before them (`touch` says whether two
+/// consecutive ones do): the order of a mesh listed strip by strip. The BVH's clusters and the
+/// Voronoi areas' patches rely on it; the loader restores it for a large mesh that lacks it
+/// (`scene/spatial_order.rs`), and the BVH builds without clusters where it is missing.
+pub(crate) fn in_strips<T: Sync>(items: &[T], touch: impl Fn(&T, &T) -> bool + Sync) -> bool {
+    let touching = items.par_windows(2).filter(|w| touch(&w[0], &w[1])).count();
+    2 * touching >= items.len()
 }
 
 /// The smallest and largest coordinates of the triangles' vertices, per axis, in parallel: min

@@ -31,7 +31,7 @@ mod ray;
 pub mod shapes;
 
 pub use aabb::Aabb;
-pub(crate) use aabb::vertex_bounds;
+pub(crate) use aabb::{in_strips, vertex_bounds};
 pub use bvh::{Bvh, InvariantError, ShadowHint};
 pub use cluster::{CLUSTER, CLUSTERED_FROM};
 pub use node::WideNode;

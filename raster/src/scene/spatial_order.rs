@@ -19,6 +19,7 @@ use lucent_core::internals::Grid;
 use rayon::prelude::*;
 
 use super::model::Mesh;
+use crate::geometry::{self, Aabb};
 
 /// Meshes of fewer triangles keep the file's order: their work is small whatever the order.
 pub const ORDERED_FROM: usize = 1 << 16;
@@ -61,22 +62,11 @@ fn grid_over(positions: &[Vec3]) -> Grid {
     Grid::new(lo, hi)
 }
 
-/// True when at least half of the mesh's triangles touch the one before them (their boxes
-/// share a point): the order of a mesh listed strip by strip.
+/// True when the mesh's triangles come in strips ([`geometry::in_strips`]): at least half of
+/// them touch the one before them.
 fn in_strips(mesh: &Mesh) -> bool {
-    let boxes = |t: &[u32; 3]| {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        (a.min(b).min(c), a.max(b).max(c))
-    };
-    let touching = mesh
-        .triangles
-        .par_windows(2)
-        .filter(|w| {
-            let ((lo0, hi0), (lo1, hi1)) = (boxes(&w[0]), boxes(&w[1]));
-            lo1.cmple(hi0).all() && lo0.cmple(hi1).all()
-        })
-        .count();
-    2 * touching >= mesh.triangles.len()
+    let bounds = |t: &[u32; 3]| Aabb::from_triangle(&t.map(|i| mesh.positions[i as usize]));
+    geometry::in_strips(&mesh.triangles, |a, b| bounds(a).touches(&bounds(b)))
 }
 
 #[cfg(test)]
