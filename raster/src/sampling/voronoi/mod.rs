@@ -673,26 +673,27 @@ impl Pass<'_> {
                         }
                     };
                     // First the patch whose box is nearest, in the run whose box is: its
-                    // distance then skips nearly every other patch.
+                    // distance then skips nearly every other patch. Visiting it again could
+                    // not change `best`, so it is not.
                     let box_to = |[lo, hi]: &[Vec3; 2]| box_distance2_below_all(p, *lo, *hi);
                     let nearest_run = cells
                         .patch_runs(c)
                         .min_by(|a, b| box_to(a.1).total_cmp(&box_to(b.1)));
-                    if let Some((run, _)) = nearest_run {
-                        let patches = run.iter().map(|&q| cells.patch(q as usize));
-                        if let Some((patch, _)) =
-                            patches.min_by(|a, b| box_to(a.1).total_cmp(&box_to(b.1)))
-                        {
-                            visit(patch, &mut best);
-                        }
-                    }
+                    let first = nearest_run.and_then(|(run, _)| {
+                        let q = run.iter().min_by(|&&a, &&b| {
+                            let [a, b] = [a, b].map(|q| box_to(cells.patch(q as usize).1));
+                            a.total_cmp(&b)
+                        })?;
+                        visit(cells.patch(*q as usize).0, &mut best);
+                        Some(*q)
+                    });
                     for (run, bounds) in cells.patch_runs(c) {
                         if box_to(bounds) > best.0 {
                             continue;
                         }
                         for &q in run {
                             let (patch, bounds) = cells.patch(q as usize);
-                            if patch.len() > 1 && box_to(bounds) > best.0 {
+                            if Some(q) == first || patch.len() > 1 && box_to(bounds) > best.0 {
                                 continue;
                             }
                             visit(patch, &mut best);
