@@ -16,13 +16,14 @@ use crate::memory::{self, OutOfMemory};
 
 /// Scenes of at least this many triangles are built over clusters of up to [`CLUSTER`]. On a
 /// 7.8 M-triangle sphere that took the render's preparation from 1.9 to 1.0 s (the whole
-/// render from 5.9 to 4.9 s). On the 101,920-triangle bench scene, built that way for the
-/// comparison, the build was 3.1× cheaper but random shadow rays from its surface cost 12%
-/// more and closest hits 9%; renders of a 2 M-triangle mesh did not show that cost, even with
-/// 65 rays per pixel starting on it (shading 1.14 s over clusters, 1.20 s without). Tried: a
-/// rule weighing the render's rays against the triangles; it turned clusters off where they
-/// were faster (BENCHMARKS.md, "Large meshes").
-pub const CLUSTERED_FROM: usize = 1 << 20;
+/// render from 5.9 to 4.9 s); from a quarter of a million triangles on, every render measured
+/// was faster over clusters (2–13% in total). On the 101,920-triangle bench scene, built that
+/// way for the comparison, the build was 3.1× cheaper but random shadow rays from its surface
+/// cost 12% more and closest hits 9%; near 130,000 triangles one render of three (a bumped
+/// sphere over a floor of 20,000 triangles, 65 rays per pixel) was 6% slower over clusters.
+/// Tried: a rule weighing the render's rays against the triangles; it turned clusters off
+/// where they were faster (BENCHMARKS.md, "Large meshes").
+pub const CLUSTERED_FROM: usize = 1 << 18;
 /// Most triangles in a cluster (see [`CLUSTERED_FROM`]). Two were slower for rays than four on
 /// the bench scene, and did less for the build.
 pub const CLUSTER: usize = 4;
