@@ -340,13 +340,12 @@ impl Cells {
                     let p = k * chunk.max(1) + i;
                     let range = starts[p] as usize..starts[p + 1] as usize;
                     own.clear();
-                    let mut alive = range.clone().filter(|&t| live[t]);
-                    match (alive.next(), alive.next()) {
-                        (None, _) => {}
-                        (Some(t), None) => {
+                    match Occupancy::of(range, live) {
+                        Occupancy::Empty => {}
+                        Occupancy::Single(t) => {
                             self.cells_near(&triangles[t], reach, &mut own, &mut stack)
                         }
-                        (Some(_), Some(_)) => self.cells_in_box(
+                        Occupancy::Several => self.cells_in_box(
                             lo.as_dvec3(),
                             hi.as_dvec3(),
                             reach,
@@ -505,6 +504,30 @@ impl Cells {
                 normal == DVec3::ZERO || (centre - p[0]).dot(normal).abs() <= reach + half_diagonal
             };
             self.cells_in_box(lo, hi, reach, near_plane, out);
+        }
+    }
+}
+
+/// Which of a patch's triangles have area (`live`): none, one, or several. A patch of several
+/// is handled by its box; a triangle alone by itself (registration and owners alike).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Occupancy {
+    /// No triangle with area.
+    Empty,
+    /// Exactly one, this one.
+    Single(usize),
+    /// Two or more.
+    Several,
+}
+
+impl Occupancy {
+    /// The occupancy of the triangles `range`.
+    pub(super) fn of(range: std::ops::Range<usize>, live: &[bool]) -> Occupancy {
+        let mut alive = range.filter(|&t| live[t]);
+        match (alive.next(), alive.next()) {
+            (None, _) => Occupancy::Empty,
+            (Some(t), None) => Occupancy::Single(t),
+            (Some(_), Some(_)) => Occupancy::Several,
         }
     }
 }

@@ -31,7 +31,7 @@
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-use super::cells::{Cells, PATCH_CHUNK};
+use super::cells::{Cells, Occupancy, PATCH_CHUNK};
 
 /// The owner of a triangle that is clipped: no single site holds it robustly.
 pub(super) const SHARED: u32 = u32::MAX;
@@ -67,15 +67,12 @@ pub(super) fn triangle_owners(
             for p in cells.patches_within(first..first + out.len()) {
                 let (range, &[lo, hi]) = cells.patch(p);
                 let range = range.start as usize..range.end as usize;
-                let mut alive = range.filter(|&t| live[t]).peekable();
-                let Some(&t) = alive.peek() else { continue };
-                let several = alive.clone().nth(1).is_some();
-                if several {
-                    block.search_patch(cells, lo.as_dvec3(), hi.as_dvec3());
-                } else {
-                    block.search_block(cells, triangles[t][0].as_dvec3());
+                match Occupancy::of(range.clone(), live) {
+                    Occupancy::Empty => continue,
+                    Occupancy::Single(t) => block.search_block(cells, triangles[t][0].as_dvec3()),
+                    Occupancy::Several => block.search_patch(cells, lo.as_dvec3(), hi.as_dvec3()),
                 }
-                for t in alive {
+                for t in range.filter(|&t| live[t]) {
                     out[t - first] = block.owner(cells, &triangles[t], reach);
                 }
             }
