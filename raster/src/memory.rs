@@ -29,7 +29,7 @@ pub const PIXELS: Buffer = Buffer {
 /// The depth and triangle id of every sub-sample.
 pub const VISIBILITY: Buffer = Buffer {
     what: "the visibility buffer",
-    remedy: "lower the resolution or the antialiasing",
+    remedy: "lower the resolution or the antialiasing, or render the image in tiles (--crop)",
 };
 
 /// Buffers of one or a few elements per triangle of the scene.

@@ -29,12 +29,13 @@ pub struct Fragment {
 impl VisibilityBuffer {
     /// Collects the fragments of pixel `(x, y)` into `out` (cleared first), one per distinct
     /// `key(triangle id)` among its covered sub-samples, sorted by depth (nearest first), then
-    /// by key. `out` is left empty for pixels outside the image or with nothing drawn.
+    /// by key. `out` is left empty for pixels outside the image or with nothing drawn (and for
+    /// pixels outside the window, which the caller must not ask for: debug builds assert).
     ///
     /// Allocation-free once `out` has capacity for the fragments (at most aa², usually 1–3).
     pub fn resolve(&self, x: u32, y: u32, key: impl Fn(u32) -> u32, out: &mut Vec<Fragment>) {
         out.clear();
-        if x >= self.width() || y >= self.height() {
+        if !self.holds(x, y) {
             return;
         }
         let aa = self.aa();

@@ -77,11 +77,24 @@ impl EdgeWalker {
     }
 }
 
+/// [`scan_triangle_rows`] over every row of `grid`.
+#[cfg(test)]
+pub(crate) fn scan_triangle(tri: [FixedPoint; 3], grid: Grid, span: impl FnMut(u32, u32, u32)) {
+    scan_triangle_rows(tri, grid, 0..grid.rows, span);
+}
+
 /// Calls `span(row, first_col, end_col)` (end exclusive, never empty) for every sub-sample row of
-/// `grid` the triangle covers, top to bottom, using the top-left fill rule. Works for either
-/// winding; zero-area triangles produce nothing. Coordinates must lie within ±`COORD_LIMIT`
-/// (clipping guarantees it); anything else is ignored rather than risking overflow.
-pub(crate) fn scan_triangle(tri: [FixedPoint; 3], grid: Grid, mut span: impl FnMut(u32, u32, u32)) {
+/// `grid` within `rows` that the triangle covers, top to bottom, using the top-left fill rule.
+/// Works for either winding; zero-area triangles produce nothing. Coordinates must lie within
+/// ±`COORD_LIMIT` (clipping guarantees it); anything else is ignored rather than risking
+/// overflow. The spans on `rows` are those of a scan over every row: the edge walkers start on
+/// the first row of `rows` exactly where they would arrive stepping down from the top.
+pub(crate) fn scan_triangle_rows(
+    tri: [FixedPoint; 3],
+    grid: Grid,
+    rows: std::ops::Range<u32>,
+    mut span: impl FnMut(u32, u32, u32),
+) {
     let in_range =
         |p: &FixedPoint| i64::from(p.x).abs() <= COORD_LIMIT && i64::from(p.y).abs() <= COORD_LIMIT;
     if !tri.iter().all(in_range) {
@@ -103,9 +116,10 @@ pub(crate) fn scan_triangle(tri: [FixedPoint; 3], grid: Grid, mut span: impl FnM
     }
     let long_is_left = cross > 0;
 
-    let rows = i64::from(grid.rows);
+    let first_row = i64::from(rows.start);
+    let rows = i64::from(grid.rows.min(rows.end));
     let cols = i64::from(grid.cols);
-    let row_top = first_centre_at_or_after(y0).max(0);
+    let row_top = first_centre_at_or_after(y0).max(first_row);
     let row_end = first_centre_at_or_after(y2).min(rows);
     if row_top >= row_end {
         return;
@@ -248,6 +262,38 @@ mod tests {
                 .sum::<u32>(),
             120
         );
+    }
+
+    #[test]
+    fn a_range_of_rows_gets_the_whole_scans_spans_on_it() {
+        // Random triangles, partly off the grid, raw coordinates with fractions: the walkers
+        // started on a later row must land where stepping down from the top puts them.
+        let grid = Grid { cols: 37, rows: 41 };
+        let mut rng = Rng::new(5);
+        let mut spans_checked = 0;
+        for _ in 0..3000 {
+            let mut point = || {
+                fp(
+                    rng.range_i64(-4 * ONE, 41 * ONE),
+                    rng.range_i64(-4 * ONE, 45 * ONE),
+                )
+            };
+            let tri = [point(), point(), point()];
+            let mut whole = Vec::new();
+            scan_triangle(tri, grid, |r, a, b| whole.push((r, a, b)));
+            for rows in [0..41, 0..1, 3..17, 17..18, 40..41, 20..20, 30..60, 41..50] {
+                let mut part = Vec::new();
+                scan_triangle_rows(tri, grid, rows.clone(), |r, a, b| part.push((r, a, b)));
+                let want: Vec<_> = whole
+                    .iter()
+                    .copied()
+                    .filter(|s| rows.contains(&s.0))
+                    .collect();
+                assert_eq!(part, want, "rows {rows:?} of {tri:?}");
+                spans_checked += part.len();
+            }
+        }
+        assert!(spans_checked > 10_000, "{spans_checked}");
     }
 
     #[test]

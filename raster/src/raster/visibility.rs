@@ -9,8 +9,9 @@ use rayon::prelude::*;
 
 use super::clip::clip_and_project;
 use super::fixed::{Grid, MAX_GRID_AXIS};
-use super::scan::scan_triangle;
+use super::scan::scan_triangle_rows;
 use crate::memory::{self, OutOfMemory};
+use crate::output::Region;
 
 /// The triangle id of an empty sub-sample.
 pub const EMPTY: u32 = u32::MAX;
@@ -36,6 +37,15 @@ pub enum RasterError {
         /// The requested value.
         aa: u32,
     },
+    /// The window of a [`VisibilityBuffer::new_window`] is empty or not inside the image.
+    WindowOutside {
+        /// The requested window.
+        window: Region,
+        /// Image width in pixels.
+        width: u32,
+        /// Image height in pixels.
+        height: u32,
+    },
     /// The sub-sample grid is larger than supported (2^20 per axis, 2^28 in total).
     TooLarge {
         /// Requested width in pixels.
@@ -58,11 +68,20 @@ impl fmt::Display for RasterError {
             Self::InvalidAa { aa } => {
                 write!(f, "aa = {aa} sub-samples per axis is outside 1..={MAX_AA}")
             }
+            Self::WindowOutside {
+                window,
+                width,
+                height,
+            } => write!(
+                f,
+                "visibility window {window} is empty or not inside the {width}×{height} image"
+            ),
             Self::TooLarge { width, height, aa } => write!(
                 f,
                 "visibility buffer of {width}×{height} pixels with aa = {aa} exceeds \
                  {MAX_GRID_AXIS} sub-samples per axis or {MAX_SUBSAMPLES} in total (lower the \
-                 resolution or the antialiasing: 'aa' in [render], or --aa)"
+                 resolution or the antialiasing: 'aa' in [render], or --aa; or render the image in \
+                 tiles, --crop, and merge them)"
             ),
             Self::OutOfMemory(e) => write!(f, "{e}"),
         }
@@ -92,6 +111,13 @@ impl Error for RasterError {}
 /// The scan converter fills horizontal runs of this grid, so a span is one contiguous slice of
 /// each array; resolving a pixel reads `aa` short runs.
 ///
+/// A buffer made by [`VisibilityBuffer::new_window`] holds only a **window** of the image's
+/// pixels (a tile and the pixels its shading reads): the arrays are the sub-sample grid of
+/// the window alone, `window.width()·aa` entries a row, while triangles are still projected
+/// and scanned on the whole image's grid and their spans cut to the window. Every sub-sample
+/// of the window gets the bits the whole image's buffer has there, and a tile of a large
+/// image needs the memory of the tile, not of the image.
+///
 /// Depth is NDC `z = z_clip / w_clip` in [0, 1] (glam's `perspective_rh`), smaller is nearer,
 /// interpolated affinely in screen space (NDC depth is affine in screen space, which is why
 /// z-buffers store it). An empty sub-sample has depth `+∞` and id [`EMPTY`]. The depth test is a
@@ -102,7 +128,10 @@ pub struct VisibilityBuffer {
     width: u32,
     height: u32,
     aa: u32,
+    /// The whole image's sub-sample grid, on which triangles are scanned.
     grid: Grid,
+    /// The pixels held: the whole image unless made by [`VisibilityBuffer::new_window`].
+    window: Region,
     /// NDC depth per sub-sample, `+∞` when empty.
     depth: Vec<f32>,
     /// Triangle id per sub-sample, [`EMPTY`] when empty.
@@ -118,25 +147,55 @@ impl VisibilityBuffer {
     /// Sizes are validated before anything is allocated, and allocation failure is reported
     /// rather than aborting.
     pub fn new(width: u32, height: u32, aa: u32) -> Result<Self, RasterError> {
+        Self::new_window(width, height, aa, Region::full(width, height))
+    }
+
+    /// An empty buffer of a `width × height` image with `aa × aa` sub-samples per pixel that
+    /// holds only the pixels of `window` (see the layout above). The limit of
+    /// [`MAX_SUBSAMPLES`] applies to the window, the one per axis to the image.
+    pub fn new_window(
+        width: u32,
+        height: u32,
+        aa: u32,
+        window: Region,
+    ) -> Result<Self, RasterError> {
         if width == 0 || height == 0 {
             return Err(RasterError::EmptyImage { width, height });
         }
         if !(1..=MAX_AA).contains(&aa) {
             return Err(RasterError::InvalidAa { aa });
         }
+        if window.check_within(width, height).is_err() {
+            return Err(RasterError::WindowOutside {
+                window,
+                width,
+                height,
+            });
+        }
         let (cols, rows) = (
             u64::from(width) * u64::from(aa),
             u64::from(height) * u64::from(aa),
         );
         let axis = u64::from(MAX_GRID_AXIS);
-        if cols > axis || rows > axis || cols * rows > MAX_SUBSAMPLES {
+        if cols > axis || rows > axis {
             return Err(RasterError::TooLarge { width, height, aa });
         }
-        let len = (cols * rows) as usize; // ≤ 2^28
+        let (held_cols, held_rows) = (
+            u64::from(window.width()) * u64::from(aa),
+            u64::from(window.height()) * u64::from(aa),
+        );
+        if held_cols * held_rows > MAX_SUBSAMPLES {
+            return Err(RasterError::TooLarge {
+                width: window.width(),
+                height: window.height(),
+                aa,
+            });
+        }
+        let len = (held_cols * held_rows) as usize; // ≤ 2^28
         // A refusal names the whole buffer: depth and ids, 8 bytes per sub-sample.
         let whole = |e: OutOfMemory| {
             RasterError::OutOfMemory(OutOfMemory {
-                bytes: cols * rows * 8,
+                bytes: held_cols * held_rows * 8,
                 ..e
             })
         };
@@ -160,6 +219,7 @@ impl VisibilityBuffer {
                 cols: cols as u32,
                 rows: rows as u32,
             },
+            window,
             depth,
             triangle,
             centre_order,
@@ -181,12 +241,19 @@ impl VisibilityBuffer {
         self.aa
     }
 
-    /// `(cols, rows)` of the sub-sample grid: `(width·aa, height·aa)`.
+    /// `(cols, rows)` of the image's sub-sample grid: `(width·aa, height·aa)`.
     pub fn grid_size(&self) -> (u32, u32) {
         (self.grid.cols, self.grid.rows)
     }
 
-    /// Depth per sub-sample, row-major over the sub-sample grid (see the module docs).
+    /// The pixels the buffer holds (the whole image unless made by
+    /// [`VisibilityBuffer::new_window`]).
+    pub fn window(&self) -> Region {
+        self.window
+    }
+
+    /// Depth per sub-sample, row-major over the window's sub-sample grid (the image's for a
+    /// buffer of the whole image; see the layout above).
     pub fn depths(&self) -> &[f32] {
         &self.depth
     }
@@ -204,9 +271,10 @@ impl VisibilityBuffer {
     }
 
     /// `(triangle id, depth)` of sub-sample `(i, j)` of pixel `(x, y)`; `None` when out of
-    /// range or empty.
+    /// range or empty. A pixel of the image outside the window is a caller's error (debug
+    /// builds assert); it reads as empty.
     pub fn sample(&self, x: u32, y: u32, i: u32, j: u32) -> Option<(u32, f32)> {
-        if x >= self.width || y >= self.height || i >= self.aa || j >= self.aa {
+        if !self.holds(x, y) || i >= self.aa || j >= self.aa {
             return None;
         }
         let idx = self.index(x, y, i, j);
@@ -214,10 +282,26 @@ impl VisibilityBuffer {
         (id != EMPTY).then(|| (id, self.depth[idx]))
     }
 
-    /// Index of sub-sample `(i, j)` of pixel `(x, y)` (arguments in range).
+    /// True when pixel `(x, y)` lies in the window; asserts (debug builds) that a pixel of the
+    /// image is not read outside it, which would give a tile other bits than the whole image.
+    #[inline]
+    pub(super) fn holds(&self, x: u32, y: u32) -> bool {
+        let held = self.window.contains(x, y);
+        debug_assert!(
+            held || x >= self.width || y >= self.height,
+            "pixel ({x}, {y}) read outside the visibility window {}",
+            self.window
+        );
+        held
+    }
+
+    /// Index of sub-sample `(i, j)` of pixel `(x, y)` (arguments in range, the pixel in the
+    /// window).
     #[inline]
     pub(super) fn index(&self, x: u32, y: u32, i: u32, j: u32) -> usize {
-        (y * self.aa + j) as usize * self.grid.cols as usize + (x * self.aa + i) as usize
+        let w = &self.window;
+        let cols = (w.width() * self.aa) as usize;
+        ((y - w.y0) * self.aa + j) as usize * cols + ((x - w.x0) * self.aa + i) as usize
     }
 
     /// Empties every sub-sample.
@@ -238,13 +322,31 @@ impl VisibilityBuffer {
         }
         let poly = clip_and_project(clip, self.grid);
         let plane = poly.depth;
-        let cols = self.grid.cols as usize;
+        let w = &self.window;
+        let (first_col, end_col) = (w.x0 * self.aa, w.x1 * self.aa);
+        let rows = w.y0 * self.aa..w.y1 * self.aa;
+        let cols = (end_col - first_col) as usize;
         let (depth, triangle) = (&mut self.depth, &mut self.triangle);
         for tri in poly.triangles() {
-            scan_triangle(tri, self.grid, |row, c0, c1| {
-                let range = row as usize * cols + c0 as usize..row as usize * cols + c1 as usize;
+            scan_triangle_rows(tri, self.grid, rows.clone(), |row, c0, c1| {
+                // The span cut to the window; its depths still count from the span's start
+                // (`z0` at c0), as the whole image's do.
+                let (a, b) = (c0.max(first_col), c1.min(end_col));
+                if a >= b {
+                    return;
+                }
+                let at = (row - rows.start) as usize * cols;
+                let range = at + (a - first_col) as usize..at + (b - first_col) as usize;
                 let (z0, dz) = plane.span(row, c0);
-                depth_test_span(&mut depth[range.clone()], &mut triangle[range], z0, dz, id);
+                let skipped = (a - c0) as f32;
+                depth_test_span(
+                    &mut depth[range.clone()],
+                    &mut triangle[range],
+                    z0,
+                    dz,
+                    skipped,
+                    id,
+                );
             });
         }
     }
@@ -291,7 +393,7 @@ impl VisibilityBuffer {
         }
         // The other runs' buffers; if one cannot be had, the mesh is drawn on one thread.
         let Ok(mut others) = (1..runs)
-            .map(|_| VisibilityBuffer::new(self.width, self.height, self.aa))
+            .map(|_| VisibilityBuffer::new_window(self.width, self.height, self.aa, self.window))
             .collect::<Result<Vec<_>, _>>()
         else {
             self.draw_run(view_proj, positions, triangles, first_id, 0);
@@ -348,7 +450,7 @@ impl VisibilityBuffer {
     }
 
     /// Takes `later`'s sub-samples where they are strictly nearer: `later` holds triangles
-    /// drawn after every one of this buffer's (the same size).
+    /// drawn after every one of this buffer's (the same image and window).
     fn merge_later(&mut self, later: &VisibilityBuffer) {
         let pairs = self.depth.iter_mut().zip(&mut self.triangle);
         for ((depth, id), (&later_depth, &later_id)) in
@@ -371,8 +473,9 @@ const PARALLEL_MAX_BYTES: u64 = 256 << 20;
 /// Lanes per chunk of [`depth_test_span`]: eight `f32` fill one AVX register or two SSE ones.
 const LANES: usize = 8;
 
-/// Depth-tests one span: sub-sample `k` gets depth `clamp(z0 + k·dz, 0, 1)` and takes `id` where
-/// that is strictly less than the stored depth.
+/// Depth-tests one span: its sub-sample `k` gets depth `clamp(z0 + (first + k)·dz, 0, 1)` and
+/// takes `id` where that is strictly less than the stored depth (`first` > 0: the span's
+/// first `first` sub-samples lie outside the buffer's window).
 ///
 /// The span is processed in chunks of [`LANES`] whose results are computed into local arrays
 /// and written back unconditionally, so the compiler vectorises the compare-and-select (a plain
@@ -380,11 +483,11 @@ const LANES: usize = 8;
 /// bench: ≈ 690 M sub-samples/s plain, ≈ 900 M/s chunked). `k` is carried as an `f32`, exact
 /// because spans are shorter than 2^24, so every lane computes exactly what a scalar loop would.
 #[inline]
-fn depth_test_span(depths: &mut [f32], ids: &mut [u32], z0: f32, dz: f32, id: u32) {
+fn depth_test_span(depths: &mut [f32], ids: &mut [u32], z0: f32, dz: f32, first: f32, id: u32) {
     let depth_at = |k: f32| (z0 + dz * k).clamp(0.0, 1.0);
     let mut d_chunks = depths.chunks_exact_mut(LANES);
     let mut t_chunks = ids.chunks_exact_mut(LANES);
-    let mut base = 0.0f32;
+    let mut base = first;
     for (d, t) in (&mut d_chunks).zip(&mut t_chunks) {
         let mut new_d = [0.0f32; LANES];
         let mut new_t = [0u32; LANES];
@@ -557,10 +660,11 @@ mod tests {
                 .collect();
             let old_t: Vec<u32> = (0..len).map(|k| k as u32).collect();
             let (z0, dz) = (rng.f32_in(-0.2, 1.2), rng.f32_in(-0.1, 0.1));
+            let first = (len % 5) as f32 * 3.0;
             let (mut d, mut t) = (old_d.clone(), old_t.clone());
-            depth_test_span(&mut d, &mut t, z0, dz, 99);
+            depth_test_span(&mut d, &mut t, z0, dz, first, 99);
             for k in 0..len {
-                let z = (z0 + dz * k as f32).clamp(0.0, 1.0);
+                let z = (z0 + dz * (first + k as f32)).clamp(0.0, 1.0);
                 let (want_d, want_t) = if z < old_d[k] {
                     (z, 99)
                 } else {
@@ -619,6 +723,129 @@ mod tests {
                 assert_eq!(bits(&merged), bits(&one), "{runs} runs");
             }
         }
+    }
+
+    /// A buffer holding a window of the image has, at every sub-sample of the window, the
+    /// whole image's triangle and depth to the bit: spans cut at the window's left edge keep
+    /// the depths counted from their start, rows above it are skipped exactly, and a mesh
+    /// drawn in runs merges alike.
+    #[test]
+    fn a_window_holds_the_whole_images_bits() {
+        let mut rng = Rng::new(0x5eed);
+        let mut next = || rng.f32_in(0.0, 1.0);
+        let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+        for _ in 0..400u32 {
+            let centre = Vec3::new(next() * 2.6 - 1.3, next() * 2.6 - 1.3, next() - 0.5);
+            let size = 0.05 + next() * 0.9;
+            let base = positions.len() as u32;
+            for _ in 0..3 {
+                // Tilted: each corner at its own depth, so that depths vary along a span.
+                let offset = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * size;
+                positions.push(centre + offset);
+            }
+            triangles.push([base, base + 1, base + 2]);
+        }
+        let proj = Mat4::perspective_rh(1.0, 1.0, 0.1, 10.0)
+            * Mat4::from_translation(Vec3::new(0.0, 0.0, -1.5));
+        let (w, h) = (37u32, 29u32);
+        for aa in [1, 2, 3] {
+            let mut whole = VisibilityBuffer::new(w, h, aa).unwrap();
+            whole.draw_in_runs(proj, &positions, &triangles, 0, 1);
+            let windows = [
+                Region::full(w, h),
+                Region {
+                    x0: 5,
+                    y0: 3,
+                    x1: 20,
+                    y1: 17,
+                },
+                Region {
+                    x0: 0,
+                    y0: 28,
+                    x1: 37,
+                    y1: 29,
+                },
+                Region {
+                    x0: 36,
+                    y0: 0,
+                    x1: 37,
+                    y1: 29,
+                },
+                Region {
+                    x0: 11,
+                    y0: 11,
+                    x1: 12,
+                    y1: 12,
+                },
+            ];
+            let mut seen = 0;
+            for (k, window) in windows.into_iter().enumerate() {
+                let mut part = VisibilityBuffer::new_window(w, h, aa, window).unwrap();
+                part.draw_in_runs(proj, &positions, &triangles, 0, 1 + k % 3);
+                let held = (window.width() * window.height() * aa * aa) as usize;
+                assert_eq!(part.depths().len(), held);
+                for y in window.y0..window.y1 {
+                    for x in window.x0..window.x1 {
+                        for (i, j) in (0..aa).flat_map(|j| (0..aa).map(move |i| (i, j))) {
+                            let bits = |b: &VisibilityBuffer| {
+                                b.sample(x, y, i, j).map(|(t, d)| (t, d.to_bits()))
+                            };
+                            assert_eq!(bits(&part), bits(&whole), "aa {aa} {window} ({x}, {y})");
+                            seen += usize::from(bits(&part).is_some());
+                        }
+                    }
+                }
+            }
+            assert!(
+                seen > 1000 * (aa * aa) as usize,
+                "aa {aa}: {seen} sub-samples drawn"
+            );
+        }
+    }
+
+    #[test]
+    fn a_window_is_checked_and_bounds_only_its_own_size() {
+        let outside = Region {
+            x0: 2,
+            y0: 2,
+            x1: 9,
+            y1: 4,
+        };
+        assert_eq!(
+            VisibilityBuffer::new_window(8, 8, 2, outside).unwrap_err(),
+            RasterError::WindowOutside {
+                window: outside,
+                width: 8,
+                height: 8
+            }
+        );
+        let empty = Region {
+            x0: 3,
+            y0: 3,
+            x1: 3,
+            y1: 5,
+        };
+        assert!(VisibilityBuffer::new_window(8, 8, 2, empty).is_err());
+        // 16384² pixels at aa = 2 exceed the sub-samples a buffer may hold; a window of it
+        // does not, so tiles can render images larger than one buffer.
+        assert!(VisibilityBuffer::new(1 << 14, 1 << 14, 2).is_err());
+        let tile = Region {
+            x0: 9000,
+            y0: 100,
+            x1: 9512,
+            y1: 612,
+        };
+        let buf = VisibilityBuffer::new_window(1 << 14, 1 << 14, 2, tile).unwrap();
+        assert_eq!(buf.depths().len(), 512 * 512 * 4);
+        assert_eq!((buf.grid_size(), buf.window()), ((1 << 15, 1 << 15), tile));
+        // The axis limit stays the image's: the fixed-point grid spans the whole image.
+        let small = Region {
+            x0: 0,
+            y0: 0,
+            x1: 1,
+            y1: 1,
+        };
+        assert!(VisibilityBuffer::new_window(1 << 20, 1, 2, small).is_err());
     }
 
     #[test]

@@ -87,8 +87,9 @@ pub struct RenderOptions<'a> {
     /// normals or material (the `adaptive` module). For measurements and tests.
     pub shade_once: bool,
     /// Render only this region of the image (a tile): every pixel of it is bit for bit the
-    /// same pixel of the whole render. The image is rasterised whole; the first pass also
-    /// shades a one-pixel margin around the region, which the second pass compares with.
+    /// same pixel of the whole render. The first pass also shades a one-pixel margin around
+    /// the region, which the second pass compares with; the visibility buffer holds only the
+    /// pixels shading reads ([`rasterize_window`]).
     pub crop: Option<Region>,
 }
 
@@ -388,9 +389,25 @@ fn render_in_pool(
     }
     timings.cache = t.elapsed();
 
-    // Rasterise every object.
+    // The second pass compares each pixel with its eight neighbours' first-pass values, so
+    // the first pass covers a one-pixel margin around the region.
+    let refine = scene.render.aa > 1 && !options.shade_once;
+    let shaded = region.grown(u32::from(refine), camera.width, camera.height);
+    let interpolation = (settings.interpolation > 1 && !prep.translucent_objects().is_empty())
+        .then_some(Interpolation {
+            step: settings.interpolation,
+            tolerance: settings.interpolation_tolerance,
+        });
+
+    // Rasterise every object, into the pixels shading reads: the shaded ones, and with
+    // interpolation the grid pixels up to a step beyond them.
     let t = Instant::now();
-    let (visibility, view_proj) = rasterize(&prep)?;
+    let read = shaded.grown(
+        interpolation.map_or(0, |i| i.step),
+        camera.width,
+        camera.height,
+    );
+    let (visibility, view_proj) = rasterize_window(&prep, read)?;
     timings.raster = t.elapsed();
 
     // Shade.
@@ -406,16 +423,7 @@ fn render_in_pool(
         view_proj,
         visibility: &visibility,
     };
-    // The second pass compares each pixel with its eight neighbours' first-pass values, so
-    // the first pass covers a one-pixel margin around the region.
-    let refine = scene.render.aa > 1 && !options.shade_once;
-    let shaded = region.grown(u32::from(refine), camera.width, camera.height);
     let b = bar(options.progress, u64::from(shaded.height()), "shading");
-    let interpolation = (settings.interpolation > 1 && !prep.translucent_objects().is_empty())
-        .then_some(Interpolation {
-            step: settings.interpolation,
-            tolerance: settings.interpolation_tolerance,
-        });
     // With interpolation, the image is shaded in bands of grid rows, each after its grid.
     let band_rows = match interpolation {
         Some(i) => i.step * BAND_GRID_ROWS,
@@ -541,12 +549,23 @@ fn render_in_pool(
 /// returns the world → clip transform used. Triangle ids are indices into
 /// [`Prepared::triangles`].
 pub fn rasterize(prep: &Prepared) -> Result<(VisibilityBuffer, glam::Mat4), RenderError> {
+    let camera = &prep.scene.camera;
+    rasterize_window(prep, Region::full(camera.width, camera.height))
+}
+
+/// [`rasterize`] into a buffer that holds only the pixels of `window` (a tile and what its
+/// shading reads), each with the bits the whole image's buffer has there.
+pub fn rasterize_window(
+    prep: &Prepared,
+    window: Region,
+) -> Result<(VisibilityBuffer, glam::Mat4), RenderError> {
     let scene = prep.scene;
     let camera = &scene.camera;
     let (near, far) = depth_range(prep, camera);
     let view_proj = camera.view_projection(near, far);
-    let mut visibility = VisibilityBuffer::new(camera.width, camera.height, scene.render.aa)
-        .map_err(RenderError::Raster)?;
+    let mut visibility =
+        VisibilityBuffer::new_window(camera.width, camera.height, scene.render.aa, window)
+            .map_err(RenderError::Raster)?;
     for (i, object) in scene.objects.iter().enumerate() {
         visibility.rasterize_mesh(
             view_proj,

@@ -86,7 +86,8 @@ fn too_many_sub_samples_name_the_antialiasing() {
         1,
         &[
             "visibility buffer of 16384×4096 pixels with aa = 3 exceeds",
-            "lower the resolution or the antialiasing: 'aa' in [render], or --aa",
+            "lower the resolution or the antialiasing: 'aa' in [render], or --aa; or render \
+             the image in tiles, --crop, and merge them",
         ],
     );
 }
