@@ -132,6 +132,9 @@ pub struct VisibilityBuffer {
     grid: Grid,
     /// The pixels held: the whole image unless made by [`VisibilityBuffer::new_window`].
     window: Region,
+    /// For a window smaller than the image, its NDC bounds grown by [`CULL_MARGIN`]:
+    /// `[x_min, x_max, y_min, y_max]`.
+    window_ndc: Option<[f64; 4]>,
     /// NDC depth per sub-sample, `+∞` when empty.
     depth: Vec<f32>,
     /// Triangle id per sub-sample, [`EMPTY`] when empty.
@@ -220,6 +223,19 @@ impl VisibilityBuffer {
                 rows: rows as u32,
             },
             window,
+            window_ndc: (!window.is_full(width, height)).then(|| {
+                // Sub-sample column c is at NDC x = 2c/cols − 1, row r at y = 1 − 2r/rows.
+                let (cols, rows, m) = (cols as f64, rows as f64, CULL_MARGIN);
+                let aa = f64::from(aa);
+                let x = |c: f64| 2.0 * c / cols - 1.0;
+                let y = |r: f64| 1.0 - 2.0 * r / rows;
+                [
+                    x(f64::from(window.x0) * aa - m),
+                    x(f64::from(window.x1) * aa + m),
+                    y(f64::from(window.y1) * aa + m),
+                    y(f64::from(window.y0) * aa - m),
+                ]
+            }),
             depth,
             triangle,
             centre_order,
@@ -317,7 +333,7 @@ impl VisibilityBuffer {
     /// `id == EMPTY`. Each covered sub-sample (top-left fill rule) whose interpolated depth is
     /// strictly less than the stored one takes this triangle's depth and id.
     pub fn rasterize_triangle(&mut self, id: u32, clip: [Vec4; 3]) {
-        if id == EMPTY {
+        if id == EMPTY || self.misses_window(&clip) {
             return;
         }
         let poly = clip_and_project(clip, self.grid);
@@ -349,6 +365,24 @@ impl VisibilityBuffer {
                 );
             });
         }
+    }
+
+    /// True when the triangle certainly covers no sub-sample of a window smaller than the image:
+    /// its three clip-space corners lie beyond one and the same edge of the window, grown by
+    /// [`CULL_MARGIN`] sub-samples, e.g. x < e·w for the left edge at NDC x = e. The inequality
+    /// is linear in clip space, so it holds over the whole triangle, and every visible point
+    /// (w > 0) projects beyond the edge, corners behind the eye included. Tiles of large scenes
+    /// would otherwise clip and project every triangle of the image; the margin keeps the test
+    /// clear of rounding.
+    fn misses_window(&self, clip: &[Vec4; 3]) -> bool {
+        let Some([x_min, x_max, y_min, y_max]) = self.window_ndc else {
+            return false;
+        };
+        let all = |beyond: fn(&Vec4, f64) -> bool, edge: f64| clip.iter().all(|v| beyond(v, edge));
+        all(|v, e| f64::from(v.x) < e * f64::from(v.w), x_min)
+            || all(|v, e| f64::from(v.x) > e * f64::from(v.w), x_max)
+            || all(|v, e| f64::from(v.y) < e * f64::from(v.w), y_min)
+            || all(|v, e| f64::from(v.y) > e * f64::from(v.w), y_max)
     }
 
     /// Rasterises an indexed mesh: triangle `k` gets id `first_id + k` and its corners are
@@ -463,6 +497,11 @@ impl VisibilityBuffer {
         }
     }
 }
+
+/// How far beyond a window's edge, in sub-samples, a triangle's corners must lie for the
+/// triangle to be skipped without clipping ([`VisibilityBuffer::misses_window`]): far more
+/// than the rounding of the projection and of the snap to 1/256 sub-sample.
+const CULL_MARGIN: f64 = 2.0;
 
 /// Meshes with at least this many triangles per thread are drawn in parallel (below it, the
 /// extra buffers cost more than the threads save).
@@ -727,15 +766,20 @@ mod tests {
 
     /// A buffer holding a window of the image has, at every sub-sample of the window, the
     /// whole image's triangle and depth to the bit: spans cut at the window's left edge keep
-    /// the depths counted from their start, rows above it are skipped exactly, and a mesh
-    /// drawn in runs merges alike.
+    /// the depths counted from their start, rows above it are skipped exactly, triangles
+    /// skipped as missing the window miss it (an eighth cross the eye plane, where a projected
+    /// triangle is not the hull of its projected corners), and a mesh drawn in runs merges
+    /// alike.
     #[test]
     fn a_window_holds_the_whole_images_bits() {
         let mut rng = Rng::new(0x5eed);
         let mut next = || rng.f32_in(0.0, 1.0);
         let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-        for _ in 0..400u32 {
-            let centre = Vec3::new(next() * 2.6 - 1.3, next() * 2.6 - 1.3, next() - 0.5);
+        for k in 0..400u32 {
+            let mut centre = Vec3::new(next() * 2.6 - 1.3, next() * 2.6 - 1.3, next() - 0.5);
+            if k % 8 == 0 {
+                centre.z += 1.8;
+            }
             let size = 0.05 + next() * 0.9;
             let base = positions.len() as u32;
             for _ in 0..3 {
@@ -801,6 +845,36 @@ mod tests {
                 "aa {aa}: {seen} sub-samples drawn"
             );
         }
+    }
+
+    /// A triangle with a corner behind the eye whose projected corners all lie left of the
+    /// window still covers it: beyond the eye plane its projection wraps to the right. The
+    /// window's cull tests the corners in clip space, where the triangle is their hull.
+    #[test]
+    fn a_triangle_through_the_eye_plane_is_not_culled_by_its_projected_corners() {
+        let clip = [
+            Vec4::new(-1.0, -0.5, 0.5, 1.0),
+            Vec4::new(2.0, 0.0, -0.5, -1.0), // behind the eye: x/w = −2
+            Vec4::new(-1.0, 0.5, 0.5, 1.0),
+        ];
+        let right = Region {
+            x0: 8,
+            y0: 0,
+            x1: 16,
+            y1: 16,
+        };
+        let mut whole = VisibilityBuffer::new(16, 16, 1).unwrap();
+        let mut part = VisibilityBuffer::new_window(16, 16, 1, right).unwrap();
+        whole.rasterize_triangle(1, clip);
+        part.rasterize_triangle(1, clip);
+        let drawn = |b: &VisibilityBuffer| {
+            (8..16)
+                .flat_map(|x| (0..16).map(move |y| (x, y)))
+                .filter(|&(x, y)| b.sample(x, y, 0, 0).is_some())
+                .count()
+        };
+        assert!(drawn(&whole) > 4, "{}", drawn(&whole));
+        assert_eq!(drawn(&part), drawn(&whole));
     }
 
     #[test]
