@@ -46,7 +46,8 @@ pub enum RasterError {
         /// Image height in pixels.
         height: u32,
     },
-    /// The sub-sample grid is larger than supported (2^20 per axis, 2^28 in total).
+    /// The sub-sample grid is larger than supported (2^20 per axis of the image, 2^28 in the
+    /// pixels held).
     TooLarge {
         /// Requested width in pixels.
         width: u32,
@@ -132,6 +133,8 @@ pub struct VisibilityBuffer {
     grid: Grid,
     /// The pixels held: the whole image unless made by [`VisibilityBuffer::new_window`].
     window: Region,
+    /// Sub-samples per row of the arrays: `window.width()·aa`.
+    held_cols: usize,
     /// For a window smaller than the image, its NDC bounds grown by [`CULL_MARGIN`]:
     /// `[x_min, x_max, y_min, y_max]`.
     window_ndc: Option<[f64; 4]>,
@@ -223,6 +226,7 @@ impl VisibilityBuffer {
                 rows: rows as u32,
             },
             window,
+            held_cols: held_cols as usize,
             window_ndc: (!window.is_full(width, height)).then(|| {
                 // Sub-sample column c is at NDC x = 2c/cols − 1, row r at y = 1 − 2r/rows.
                 let (cols, rows, m) = (cols as f64, rows as f64, CULL_MARGIN);
@@ -316,8 +320,7 @@ impl VisibilityBuffer {
     #[inline]
     pub(super) fn index(&self, x: u32, y: u32, i: u32, j: u32) -> usize {
         let w = &self.window;
-        let cols = (w.width() * self.aa) as usize;
-        ((y - w.y0) * self.aa + j) as usize * cols + ((x - w.x0) * self.aa + i) as usize
+        ((y - w.y0) * self.aa + j) as usize * self.held_cols + ((x - w.x0) * self.aa + i) as usize
     }
 
     /// Empties every sub-sample.
@@ -341,7 +344,7 @@ impl VisibilityBuffer {
         let w = &self.window;
         let (first_col, end_col) = (w.x0 * self.aa, w.x1 * self.aa);
         let rows = w.y0 * self.aa..w.y1 * self.aa;
-        let cols = (end_col - first_col) as usize;
+        let cols = self.held_cols;
         let (depth, triangle) = (&mut self.depth, &mut self.triangle);
         for tri in poly.triangles() {
             scan_triangle_rows(tri, self.grid, rows.clone(), |row, c0, c1| {
