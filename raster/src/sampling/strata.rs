@@ -28,6 +28,7 @@
 //! four candidates. The cumulative areas are strictly increasing along `i`, so a run of
 //! consecutive candidates walks the triangles forward instead of searching them.
 
+use crate::parallel::sorted_by_key;
 use glam::{DVec3, Vec2, Vec3};
 use lucent_core::internals::Grid;
 use rayon::prelude::*;
@@ -102,23 +103,17 @@ impl Strata {
         let max_area = PIECE_CANDIDATES * total / m.max(1) as f64;
         // Morton order of the centroids; ties (identical codes) keep the input order. Every
         // pass but the running sum is parallel and gives the serial result: the bounds are
-        // exact (see `vertex_bounds`), and the sort's keys are distinct (the index is part of
-        // them). Triangles without area get a key above every code (63 bits) and are cut off
-        // after the sort: a filter before it made rayon collect in pieces and join them.
+        // exact (see `vertex_bounds`), and the sort is `sorted_by_key`'s. Triangles without
+        // area get a key above every code (63 bits) and are cut off after the sort.
         let grid = Grid::new(lo, hi);
-        let mut order: Vec<(u64, u32)> = triangles
-            .par_iter()
-            .enumerate()
-            .map(|(i, t)| {
-                let code = if triangle_area(t) > 0.0 {
-                    grid.code((t[0] + t[1] + t[2]) / 3.0)
-                } else {
-                    NO_AREA
-                };
-                (code, i as u32)
-            })
-            .collect();
-        order.par_sort_unstable();
+        let mut order = sorted_by_key(triangles.len(), |i| {
+            let t = &triangles[i];
+            if triangle_area(t) > 0.0 {
+                grid.code((t[0] + t[1] + t[2]) / 3.0)
+            } else {
+                NO_AREA
+            }
+        });
         order.truncate(order.partition_point(|&(code, _)| code != NO_AREA));
         let triangle: Vec<u32> = order.par_iter().map(|&(_, i)| i).collect();
         drop(order);

@@ -20,6 +20,7 @@ use rayon::prelude::*;
 
 use super::model::Mesh;
 use crate::geometry::{self, Aabb};
+use crate::parallel::sorted_by_key;
 
 /// Meshes of fewer triangles keep the file's order: their work is small whatever the order.
 pub const ORDERED_FROM: usize = 1 << 16;
@@ -33,18 +34,10 @@ pub(crate) fn order_spatially(mesh: &mut Mesh) -> bool {
     }
     let corners = |t: &[u32; 3]| t.map(|i| mesh.positions[i as usize]);
     let grid = grid_over(&mesh.positions);
-    // The index is part of every key, so the keys are distinct and the unstable sort gives
-    // one order for any number of threads.
-    let mut keys: Vec<(u64, u32)> = mesh
-        .triangles
-        .par_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let [a, b, c] = corners(t);
-            (grid.code((a + b + c) / 3.0), i as u32)
-        })
-        .collect();
-    keys.par_sort_unstable();
+    let keys = sorted_by_key(mesh.triangles.len(), |i| {
+        let [a, b, c] = corners(&mesh.triangles[i]);
+        grid.code((a + b + c) / 3.0)
+    });
     mesh.triangles = keys
         .par_iter()
         .map(|&(_, i)| mesh.triangles[i as usize])

@@ -27,6 +27,7 @@
 //! (cell, patch) pair and 24 per run of up to [`RUN`] pairs. While the pairs are sorted by cell
 //! they are held twice.
 
+use crate::parallel::sorted_by_key;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -118,23 +119,15 @@ impl Cells {
             run_boxes: Vec::new(),
             run_start: Vec::new(),
         };
-        // An indexed collect writes in place (a filtered one would gather pieces and copy
-        // them, twice the memory); non-finite sites get a key above every cell's and are cut
-        // off after the sort.
-        let mut keyed: Vec<(u64, u32)> = sites
-            .par_iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let key = if p.is_finite() {
-                    pack(cells.coords(p.as_dvec3()))
-                } else {
-                    u64::MAX
-                };
-                (key, i as u32)
-            })
-            .collect();
-        // Keys with their index are unique, so the unstable sort is deterministic.
-        keyed.par_sort_unstable();
+        // Non-finite sites get a key above every cell's and are cut off after the sort.
+        let mut keyed = sorted_by_key(sites.len(), |i| {
+            let p = sites[i];
+            if p.is_finite() {
+                pack(cells.coords(p.as_dvec3()))
+            } else {
+                u64::MAX
+            }
+        });
         keyed.truncate(keyed.partition_point(|&(k, _)| k != u64::MAX));
         for (k, &(key, _)) in keyed.iter().enumerate() {
             if cells.cell_key.last() != Some(&key) {
