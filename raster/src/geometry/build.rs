@@ -10,11 +10,11 @@
 //! to object-median splits, which halve the count, so no path is longer than
 //! `MEDIAN_DEPTH + 31` for fewer than 2³¹ triangles.
 //!
-//! Scenes of hundreds of thousands of triangles and more are built over *clusters* instead of single triangles
-//! (`cluster.rs`): runs of up to [`CLUSTER`](super::CLUSTER) consecutive triangles whose boxes
-//! touch and are of about one size (a strip of a scanned or tessellated mesh), each priced by
-//! the SAH as its triangles and kept whole in one leaf. The build then handles a quarter of the
-//! items at every level; rays pay for leaves of whole clusters (see
+//! Scenes of hundreds of thousands of triangles and more are built over *clusters* instead of
+//! single triangles (`cluster.rs`): runs of up to [`CLUSTER`](super::CLUSTER) consecutive
+//! triangles whose boxes touch and are of about one size (a strip of a scanned or tessellated
+//! mesh), each priced by the SAH as its triangles and kept whole in one leaf. The build then
+//! handles a quarter of the items at every level; rays pay for leaves of whole clusters (see
 //! [`CLUSTERED_FROM`](super::CLUSTERED_FROM)).
 //!
 //! Free of hashing or randomness, so the tree is a pure function of the input: large subtrees

@@ -18,7 +18,7 @@
 //! | `ray.rs` | prepared rays, the watertight triangle test, hits, origin offset |
 //! | `node.rs` | the 32-byte binary node and the 128-byte 4-wide node |
 //! | `build.rs` | binned SAH construction, collapse to the 4-wide tree |
-//! | `cluster.rs` | runs of touching triangles built as one item (scenes of millions) |
+//! | `cluster.rs` | runs of touching triangles built as one item (large scenes) |
 //! | `bvh.rs` | the BVH, its queries and `validate` |
 //! | `shapes.rs` | procedural meshes for tests and benchmarks |
 
