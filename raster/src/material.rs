@@ -371,9 +371,8 @@ fn scalar_at_value(p: &ScalarParam, log_span: f32, t: Vec3) -> Vec3 {
 
 /// The per-channel smallest and largest texel of a texture.
 fn texel_range(t: &Texture) -> (Vec3, Vec3) {
-    t.texels
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
+    t.texels()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         })
 }

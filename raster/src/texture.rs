@@ -22,6 +22,7 @@
 //! | format detection | `format` |
 //! | PNG, JPEG, TGA, BMP, HDR (`image` crate) | `image_formats` |
 //! | OpenEXR (`exr` crate) | `openexr` |
+//! | the texels in memory: 8-bit codes or linear values | `texels` |
 //! | errors | `error` |
 
 use std::path::{Path, PathBuf};
@@ -32,15 +33,18 @@ mod error;
 mod format;
 mod image_formats;
 mod openexr;
+mod texels;
 
 pub use error::{TextureError, TextureSource};
 pub use format::TextureFormat;
+use texels::Texels;
 
 /// Largest accepted texture width or height, in texels.
 pub const MAX_TEXTURE_SIDE: u32 = 16_384;
 
-/// Largest accepted number of texels (2^24, e.g. 4096 × 4096; 192 MiB as linear `Vec3`).
-pub const MAX_TEXTURE_TEXELS: u64 = 1 << 24;
+/// Largest accepted number of texels (2^26, e.g. 8192 × 8192: 192 MiB as 8-bit codes, 768 MiB
+/// as linear values).
+pub const MAX_TEXTURE_TEXELS: u64 = 1 << 26;
 
 /// A decoded RGB texture with linear values.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,8 +55,8 @@ pub struct Texture {
     pub width: u32,
     /// Height in texels.
     pub height: u32,
-    /// Row-major texels, top row first, linear RGB.
-    pub texels: Vec<Vec3>,
+    /// Row-major texels, top row first: 8-bit codes or linear RGB.
+    texels: Texels,
 }
 
 /// How the integer values stored in a file map to the texture's linear values. Floating-point
@@ -107,6 +111,42 @@ impl TextureLimits {
 }
 
 impl Texture {
+    /// A texture of linear RGB values, row-major, top row first. A `texels` shorter than
+    /// `width × height` makes a texture that samples as black.
+    pub fn from_linear(
+        path: impl Into<PathBuf>,
+        width: u32,
+        height: u32,
+        texels: Vec<Vec3>,
+    ) -> Self {
+        Texture {
+            path: path.into(),
+            width,
+            height,
+            texels: Texels::Linear(texels),
+        }
+    }
+
+    /// The linear value of texel `index` (row-major, top row first). Panics past the last.
+    pub fn texel(&self, index: usize) -> Vec3 {
+        self.texels.get(index)
+    }
+
+    /// The linear values of every texel, row-major, top row first.
+    pub fn texels(&self) -> impl ExactSizeIterator<Item = Vec3> + '_ {
+        (0..self.texels.len()).map(|i| self.texels.get(i))
+    }
+
+    /// The number of texels held.
+    pub fn texel_count(&self) -> usize {
+        self.texels.len()
+    }
+
+    /// The bytes its texels take: 3 per texel for 8-bit files, 12 for the others.
+    pub fn texel_bytes(&self) -> usize {
+        self.texels.bytes()
+    }
+
     /// Bilinear lookup with repeat wrapping. `uv = (0, 0)` is the bottom-left corner of the
     /// image (the OBJ convention), `(1, 1)` the top-right.
     ///
@@ -162,10 +202,8 @@ impl Texture {
 
     /// The bilinear blend at a footprint of this texture (or of one of the same size).
     fn sample_at(&self, at: &Footprint) -> Vec3 {
-        let t = |row: usize, x: usize| self.texels[row + x];
-        let top = t(at.row0, at.x0).lerp(t(at.row0, at.x1), at.fx);
-        let bottom = t(at.row1, at.x0).lerp(t(at.row1, at.x1), at.fx);
-        top.lerp(bottom, at.fy)
+        self.texels
+            .blend([at.row0, at.row1, at.x0, at.x1], at.fx, at.fy)
     }
 
     /// Decodes a file held in memory, its format detected from its content
@@ -215,13 +253,13 @@ impl Texture {
                 ),
             ));
         }
-        if let Some(i) = texels.iter().position(|t| !t.is_finite()) {
+        if let Some(i) = texels.first_non_finite() {
             let (x, y) = (i % width as usize, i / width as usize);
             return Err(TextureError::new(
                 path,
                 format!(
                     "texel ({x}, {y}) (column, row from the top) is {}: {} values must be finite",
-                    texels[i],
+                    texels.get(i),
                     format.name()
                 ),
             ));

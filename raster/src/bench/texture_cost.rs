@@ -197,12 +197,7 @@ fn versions(scene: &Scene) -> Result<[Scene; 3], BenchError> {
 
 /// A 2 × 2 texture of one linear value.
 fn texture(name: &str, value: Vec3) -> Arc<Texture> {
-    Arc::new(Texture {
-        path: name.into(),
-        width: 2,
-        height: 2,
-        texels: vec![value; 4],
-    })
+    Arc::new(Texture::from_linear(name, 2, 2, vec![value; 4]))
 }
 
 /// Mean and largest relative difference of `a`'s exitance against `b`'s over the pixels where

@@ -74,22 +74,21 @@ impl EnvironmentMap {
     /// or not finite, or if the map is empty; an all-black map is valid and delivers no light.
     pub fn new(texture: Arc<Texture>) -> Result<EnvironmentMap, String> {
         let (w, h) = (texture.width as usize, texture.height as usize);
-        if w == 0 || h == 0 || texture.texels.len() != w * h {
+        if w == 0 || h == 0 || texture.texel_count() != w * h {
             return Err(format!(
                 "the map has no texels ({} × {})",
                 texture.width, texture.height
             ));
         }
         if let Some(k) = texture
-            .texels
-            .iter()
+            .texels()
             .position(|t| !t.is_finite() || t.min_element() < 0.0)
         {
             return Err(format!(
                 "map texel (column {}, row {}) is {} (radiance must be finite and at least 0)",
                 k % w,
                 k / w,
-                texture.texels[k]
+                texture.texel(k)
             ));
         }
         let row_solid_angle: Vec<f64> = (0..h)
@@ -100,12 +99,12 @@ impl EnvironmentMap {
             .collect();
         let mut column_cdf = Vec::with_capacity(h * (w + 1));
         let mut row_mass = Vec::with_capacity(h);
-        for (j, row) in texture.texels.chunks_exact(w).enumerate() {
+        for j in 0..h {
             let start = column_cdf.len();
             let mut sum = 0.0f64;
             column_cdf.push(0.0);
-            for t in row {
-                sum += luminance(*t) as f64;
+            for i in 0..w {
+                sum += luminance(texture.texel(j * w + i)) as f64;
                 column_cdf.push(sum as f32);
             }
             normalise(&mut column_cdf[start..], sum);
@@ -212,7 +211,7 @@ impl EnvironmentMap {
     pub fn radiance_and_pdf(&self, d: Vec3) -> (Vec3, f32) {
         let (i, j) = self.texel_of(d);
         let w = self.texture.width as usize;
-        let radiance = self.texture.texels[j * w + i];
+        let radiance = self.texture.texel(j * w + i);
         if self.is_black() {
             return (radiance, 0.0);
         }
@@ -242,7 +241,7 @@ impl EnvironmentMap {
         let (sin_phi, cos_phi) = phi.sin_cos();
         Some(MapSample {
             direction: Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta),
-            radiance: self.texture.texels[j * w + i],
+            radiance: self.texture.texel(j * w + i),
             pdf: row_p * column_p / self.row_solid_angle[j],
         })
     }

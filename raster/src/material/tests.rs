@@ -6,12 +6,12 @@ use crate::scene::TranslucentMaterial;
 use std::path::PathBuf;
 
 fn texture(values: &[Vec3], width: u32) -> Arc<Texture> {
-    Arc::new(Texture {
-        path: PathBuf::from("test.png"),
+    Arc::new(Texture::from_linear(
+        PathBuf::from("test.png"),
         width,
-        height: values.len() as u32 / width,
-        texels: values.to_vec(),
-    })
+        values.len() as u32 / width,
+        values.to_vec(),
+    ))
 }
 
 fn translucent(medium: Medium) -> TranslucentShader {

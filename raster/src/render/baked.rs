@@ -99,7 +99,7 @@ pub fn lighting_digest(scene: &Scene) -> u64 {
                 let t = map.texture();
                 d.word(t.width);
                 d.word(t.height);
-                d.floats(t.texels.iter().flat_map(|c| c.to_array()));
+                d.floats(t.texels().flat_map(|c| c.to_array()));
             }
             // Every other light is a few numbers; its debug form lists them all.
             other => d.text(&format!("{other:?}")),

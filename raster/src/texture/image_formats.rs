@@ -4,9 +4,10 @@
 //! The header is read first and its size checked against the [`TextureLimits`] before any pixel
 //! memory exists; the decoder's own allocation cap (`image::Limits::max_alloc`) is a second
 //! line behind it. Decoded pixels of every layout the codecs produce (grey, grey + alpha, RGB,
-//! RGBA; 8 bits, 16 bits, 32-bit float) become linear RGB: grey is replicated, alpha dropped,
-//! integer codes normalised (`code / (2^bits − 1)`) and then decoded by the
-//! [`TextureEncoding`]; float samples are taken as they are.
+//! RGBA; 8 bits, 16 bits, 32-bit float) become RGB: grey is replicated, alpha dropped. 8-bit
+//! codes are kept, beside the table of their values (`code / 255` decoded by the
+//! [`TextureEncoding`]); 16-bit codes become linear values the same way (`code / 65535`); float
+//! samples are taken as they are.
 
 use std::io::Cursor;
 use std::path::Path;
@@ -14,10 +15,12 @@ use std::path::Path;
 use glam::Vec3;
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
 
-use super::{TextureEncoding, TextureError, TextureFormat, TextureLimits, TextureSource, decode};
+use super::{
+    Texels, TextureEncoding, TextureError, TextureFormat, TextureLimits, TextureSource, decode,
+};
 
 /// The decoded size and texels (row-major, top row first).
-pub(super) type Decoded = (u32, u32, Vec<Vec3>);
+pub(super) type Decoded = (u32, u32, Texels);
 
 /// Decodes `bytes` as `format` (not [`TextureFormat::Exr`]).
 pub(super) fn decode_with_image(
@@ -73,7 +76,7 @@ pub(super) fn decode_with_image(
             ),
         ));
     }
-    let texels = linear_texels(image, encoding).ok_or_else(|| {
+    let texels = texels_of(image, encoding).ok_or_else(|| {
         TextureError::new(
             path,
             format!("{} decoder returned an unknown pixel layout", format.name()),
@@ -95,33 +98,48 @@ fn png_header_size(bytes: &[u8]) -> Option<(u32, u32)> {
 }
 
 /// Converts every pixel layout the five codecs produce; `None` for any other.
-fn linear_texels(image: DynamicImage, encoding: TextureEncoding) -> Option<Vec<Vec3>> {
-    let lut8: Vec<f32> = (0..256u32)
-        .map(|c| decode(c as f32 / 255.0, encoding))
-        .collect();
-    let code8 = |c: u8| lut8[usize::from(c)];
+fn texels_of(image: DynamicImage, encoding: TextureEncoding) -> Option<Texels> {
+    let values: [f32; 256] = core::array::from_fn(|c| decode(c as f32 / 255.0, encoding));
     let code16 = |c: u16| decode(f32::from(c) / f32::from(u16::MAX), encoding);
     let rgb = |p: [f32; 3]| Vec3::from_array(p);
-    Some(match image {
-        DynamicImage::ImageLuma8(b) => b.pixels().map(|p| Vec3::splat(code8(p.0[0]))).collect(),
-        DynamicImage::ImageLumaA8(b) => b.pixels().map(|p| Vec3::splat(code8(p.0[0]))).collect(),
-        DynamicImage::ImageRgb8(b) => b.pixels().map(|p| rgb(p.0.map(code8))).collect(),
-        DynamicImage::ImageRgba8(b) => b
-            .pixels()
-            .map(|p| rgb([p.0[0], p.0[1], p.0[2]].map(code8)))
-            .collect(),
-        DynamicImage::ImageLuma16(b) => b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect(),
-        DynamicImage::ImageLumaA16(b) => b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect(),
-        DynamicImage::ImageRgb16(b) => b.pixels().map(|p| rgb(p.0.map(code16))).collect(),
-        DynamicImage::ImageRgba16(b) => b
-            .pixels()
-            .map(|p| rgb([p.0[0], p.0[1], p.0[2]].map(code16)))
-            .collect(),
-        // Floating-point samples (Radiance HDR) are linear values: no encoding applies.
-        DynamicImage::ImageRgb32F(b) => b.pixels().map(|p| rgb(p.0)).collect(),
-        DynamicImage::ImageRgba32F(b) => {
-            b.pixels().map(|p| rgb([p.0[0], p.0[1], p.0[2]])).collect()
+    let linear = |texels: Vec<Vec3>| Some(Texels::Linear(texels));
+    let codes = |codes: Vec<u8>| Some(Texels::codes(codes, values));
+    match image {
+        // 8-bit RGB is kept as decoded, without a copy.
+        DynamicImage::ImageRgb8(b) => codes(b.into_raw()),
+        DynamicImage::ImageLuma8(b) => codes(rgb_codes(&b, 1)),
+        DynamicImage::ImageLumaA8(b) => codes(rgb_codes(&b, 2)),
+        DynamicImage::ImageRgba8(b) => codes(rgb_codes(&b, 4)),
+        DynamicImage::ImageLuma16(b) => {
+            linear(b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect())
         }
-        _ => return None,
-    })
+        DynamicImage::ImageLumaA16(b) => {
+            linear(b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect())
+        }
+        DynamicImage::ImageRgb16(b) => linear(b.pixels().map(|p| rgb(p.0.map(code16))).collect()),
+        DynamicImage::ImageRgba16(b) => linear(
+            b.pixels()
+                .map(|p| rgb([p.0[0], p.0[1], p.0[2]].map(code16)))
+                .collect(),
+        ),
+        // Floating-point samples (Radiance HDR) are linear values: no encoding applies.
+        DynamicImage::ImageRgb32F(b) => linear(b.pixels().map(|p| rgb(p.0)).collect()),
+        DynamicImage::ImageRgba32F(b) => {
+            linear(b.pixels().map(|p| rgb([p.0[0], p.0[1], p.0[2]])).collect())
+        }
+        _ => None,
+    }
+}
+
+/// Three codes per pixel from pixels of `channels` codes each: grey (one or two channels, the
+/// second alpha) replicated, RGBA's alpha dropped.
+fn rgb_codes(pixels: &[u8], channels: usize) -> Vec<u8> {
+    let rgb = |p: &[u8]| {
+        if channels < 3 {
+            [p[0]; 3]
+        } else {
+            [p[0], p[1], p[2]]
+        }
+    };
+    pixels.chunks_exact(channels).flat_map(rgb).collect()
 }

@@ -18,7 +18,7 @@ use exr::prelude::{FlatSamples, MetaData, ReadChannels, ReadLayers};
 use glam::Vec3;
 
 use super::image_formats::Decoded;
-use super::{TextureError, TextureLimits, TextureSource};
+use super::{Texels, TextureError, TextureLimits, TextureSource};
 
 /// Decodes an OpenEXR file held in memory.
 pub(super) fn decode_exr(
@@ -92,10 +92,12 @@ pub(super) fn decode_exr(
         .map(|c| (c.name.to_string(), &c.sample_data))
         .collect();
     let find = |name: &str| channels.iter().find(|(n, _)| n == name).map(|(_, s)| *s);
-    let values = |s: &FlatSamples| s.values_as_f32().collect::<Vec<f32>>();
     let texels = if let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) {
-        let (r, g, b) = (values(r), values(g), values(b));
-        (0..texels).map(|i| Vec3::new(r[i], g[i], b[i])).collect()
+        let (r, g, b) = (r.values_as_f32(), g.values_as_f32(), b.values_as_f32());
+        r.zip(g)
+            .zip(b)
+            .map(|((r, g), b)| Vec3::new(r, g, b))
+            .collect()
     } else {
         let non_alpha: Vec<&(String, &FlatSamples)> =
             channels.iter().filter(|(n, _)| n != "A").collect();
@@ -124,7 +126,7 @@ pub(super) fn decode_exr(
                 ),
             ));
         };
-        values(grey).into_iter().map(Vec3::splat).collect()
+        grey.values_as_f32().map(Vec3::splat).collect()
     };
-    Ok((width, height, texels))
+    Ok((width, height, Texels::Linear(texels)))
 }

@@ -17,12 +17,7 @@ fn map(width: u32, height: u32, texel: impl Fn(u32, u32) -> Vec3) -> Arc<Environ
         .flat_map(|j| (0..width).map(move |i| (i, j)))
         .map(|(i, j)| texel(i, j))
         .collect();
-    let texture = Texture {
-        path: PathBuf::from("test.png"),
-        width,
-        height,
-        texels,
-    };
+    let texture = Texture::from_linear(PathBuf::from("test.png"), width, height, texels);
     Arc::new(EnvironmentMap::new(Arc::new(texture)).unwrap())
 }
 
@@ -341,14 +336,8 @@ fn the_lat_long_convention_and_rotation() {
 
 #[test]
 fn bad_maps_are_refused_and_black_maps_are_dark() {
-    let texture = |texels: Vec<Vec3>| {
-        Arc::new(Texture {
-            path: PathBuf::from("x.png"),
-            width: 2,
-            height: 1,
-            texels,
-        })
-    };
+    let texture =
+        |texels: Vec<Vec3>| Arc::new(Texture::from_linear(PathBuf::from("x.png"), 2, 1, texels));
     let err =
         EnvironmentMap::new(texture(vec![Vec3::ONE, Vec3::new(1.0, f32::NAN, 0.0)])).unwrap_err();
     assert!(

@@ -28,12 +28,7 @@ pub(crate) fn encode_png(
 }
 
 fn texture(width: u32, height: u32, texels: Vec<Vec3>) -> Texture {
-    Texture {
-        path: PathBuf::from("test"),
-        width,
-        height,
-        texels,
-    }
+    Texture::from_linear(PathBuf::from("test"), width, height, texels)
 }
 
 fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
@@ -141,18 +136,18 @@ fn decodes_rgb8_as_srgb_and_as_data() {
         Texture::from_bytes(&png, Path::new("a.png"), TextureEncoding::Linear).expect("decodes");
     assert_eq!((lin.width, lin.height), (2, 1));
     assert!(close(
-        lin.texels[0],
+        lin.texel(0),
         Vec3::new(1.0, 128.0 / 255.0, 0.0),
         1e-6
     ));
     assert!(close(
-        lin.texels[1],
+        lin.texel(1),
         Vec3::new(188.0 / 255.0, 10.0 / 255.0, 64.0 / 255.0),
         1e-6
     ));
     let s = Texture::from_bytes(&png, Path::new("a.png"), TextureEncoding::Srgb).expect("decodes");
-    assert!((s.texels[1].x - 0.502_886).abs() < 1e-5);
-    assert!((s.texels[1].y - 10.0 / 255.0 / 12.92).abs() < 1e-6);
+    assert!((s.texel(1).x - 0.502_886).abs() < 1e-5);
+    assert!((s.texel(1).y - 10.0 / 255.0 / 12.92).abs() < 1e-6);
 }
 
 #[test]
@@ -168,8 +163,8 @@ fn decodes_grey16_palette_and_rgba() {
     );
     let t =
         Texture::from_bytes(&png, Path::new("g.png"), TextureEncoding::Linear).expect("decodes");
-    assert!(close(t.texels[0], Vec3::splat(32768.0 / 65535.0), 1e-7));
-    assert!(close(t.texels[1], Vec3::ONE, 0.0));
+    assert!(close(t.texel(0), Vec3::splat(32768.0 / 65535.0), 1e-7));
+    assert!(close(t.texel(1), Vec3::ONE, 0.0));
     // 1-bit grey, 3 × 1: bits 1 0 1 (row padded to a byte).
     let png = encode_png(
         3,
@@ -181,7 +176,10 @@ fn decodes_grey16_palette_and_rgba() {
     );
     let t =
         Texture::from_bytes(&png, Path::new("b.png"), TextureEncoding::Linear).expect("decodes");
-    assert_eq!(t.texels, vec![Vec3::ONE, Vec3::ZERO, Vec3::ONE]);
+    assert_eq!(
+        t.texels().collect::<Vec<_>>(),
+        vec![Vec3::ONE, Vec3::ZERO, Vec3::ONE]
+    );
     // 4-bit palette, 2 × 1, indices 1 and 0.
     let palette = vec![10, 20, 30, 255, 0, 51];
     let png = encode_png(
@@ -194,12 +192,8 @@ fn decodes_grey16_palette_and_rgba() {
     );
     let t =
         Texture::from_bytes(&png, Path::new("p.png"), TextureEncoding::Linear).expect("decodes");
-    assert!(close(t.texels[0], Vec3::new(1.0, 0.0, 0.2), 1e-6));
-    assert!(close(
-        t.texels[1],
-        Vec3::new(10.0, 20.0, 30.0) / 255.0,
-        1e-6
-    ));
+    assert!(close(t.texel(0), Vec3::new(1.0, 0.0, 0.2), 1e-6));
+    assert!(close(t.texel(1), Vec3::new(10.0, 20.0, 30.0) / 255.0, 1e-6));
     // RGBA 8: alpha ignored.
     let png = encode_png(
         1,
@@ -211,7 +205,7 @@ fn decodes_grey16_palette_and_rgba() {
     );
     let t =
         Texture::from_bytes(&png, Path::new("r.png"), TextureEncoding::Linear).expect("decodes");
-    assert!(close(t.texels[0], Vec3::new(0.2, 0.4, 0.6), 1e-6));
+    assert!(close(t.texel(0), Vec3::new(0.2, 0.4, 0.6), 1e-6));
     // Grey + alpha, 8 bit.
     let png = encode_png(
         1,
@@ -222,7 +216,7 @@ fn decodes_grey16_palette_and_rgba() {
         None,
     );
     let t = Texture::from_bytes(&png, Path::new("ga.png"), TextureEncoding::Srgb).expect("decodes");
-    assert!(close(t.texels[0], Vec3::ONE, 1e-6));
+    assert!(close(t.texel(0), Vec3::ONE, 1e-6));
 }
 
 #[test]

@@ -108,19 +108,19 @@ fn scene_textures_match_their_patterns() {
     assert_eq!((kd.width, kd.height), (SIDE as u32, SIDE as u32));
     // Away from the checker's edges (where the JPEG rings and chroma is shared) within a few
     // codes; everywhere within a bound that still tells the two colours apart.
-    for (i, t) in kd.texels.iter().enumerate() {
+    for (i, t) in kd.texels().enumerate() {
         let (x, y) = (i % SIDE, i / SIDE);
         let want = Vec3::from_array(kd_codes(x, y).map(|c| c as f32 / 255.0));
         let inner = (2..14).contains(&(x % 16)) && (2..14).contains(&(y % 16));
         let tolerance = if inner { 4.0 } else { 40.0 } / 255.0;
         assert!(
-            (*t - want).abs().max_element() <= tolerance,
+            (t - want).abs().max_element() <= tolerance,
             "kd texel ({x}, {y}): {t} vs {want}"
         );
     }
     let mfp = Texture::load(&exr_path, TextureEncoding::Linear).unwrap();
     assert_eq!((mfp.width, mfp.height), (SIDE as u32, SIDE as u32));
-    for (i, t) in mfp.texels.iter().enumerate() {
+    for (i, t) in mfp.texels().enumerate() {
         let want = mfp_t(i % SIDE, i / SIDE).map(|v| f16::from_f32(v).to_f32());
         assert_eq!(t.to_array(), want, "mfp texel {i}");
     }
