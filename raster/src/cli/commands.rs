@@ -430,7 +430,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             String::new()
         };
         outln!(
-            "lucent: {}×{}{crop}, {} samples{}, {}: load {}, prepare {}, sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries{interpolated}, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} threads, simd {} → {}",
+            "lucent: {}×{}{crop}, {} samples{}, {}: load {}, prepare {}, sampling {}, irradiance {}, cache {}, raster {}, shading {} ({} queries{interpolated}, {:.3} points per pixel; second pass {}: {} pixels probed, {} refined, {} probes), total {}, cache {:.1} MB, {} thread{}, simd {} → {}",
             scene.camera.width,
             scene.camera.height,
             s.samples,
@@ -454,6 +454,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
             seconds(start.elapsed()),
             s.cache_bytes as f64 / 1e6,
             s.threads,
+            if s.threads == 1 { "" } else { "s" },
             s.simd,
             written.join(", ")
         );
