@@ -30,6 +30,7 @@
 
 mod barycentric;
 mod clip;
+mod error;
 mod fixed;
 mod resolve;
 mod scan;
@@ -41,5 +42,6 @@ mod tests;
 pub(crate) mod testutil;
 
 pub use barycentric::perspective_barycentrics;
+pub use error::RasterError;
 pub use resolve::Fragment;
-pub use visibility::{EMPTY, MAX_AA, MAX_SUBSAMPLES, RasterError, VisibilityBuffer};
+pub use visibility::{EMPTY, MAX_AA, MAX_SUBSAMPLES, VisibilityBuffer};
