@@ -8,7 +8,7 @@ use super::visibility::{MAX_AA, MAX_SUBSAMPLES};
 use crate::memory::OutOfMemory;
 use crate::output::Region;
 
-/// Why a [`VisibilityBuffer`] could not be created.
+/// Why a [`VisibilityBuffer`](super::VisibilityBuffer) could not be created.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum RasterError {
     /// Width or height is zero.
@@ -23,7 +23,7 @@ pub enum RasterError {
         /// The requested value.
         aa: u32,
     },
-    /// The window of a [`VisibilityBuffer::new_window`] is empty or not inside the image.
+    /// The window of a [`VisibilityBuffer::new_window`](super::VisibilityBuffer::new_window) is empty or not inside the image.
     WindowOutside {
         /// The requested window.
         window: Region,
