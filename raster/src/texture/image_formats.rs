@@ -4,10 +4,9 @@
 //! The header is read first and its size checked against the [`TextureLimits`] before any pixel
 //! memory exists; the decoder's own allocation cap (`image::Limits::max_alloc`) is a second
 //! line behind it. Decoded pixels of every layout the codecs produce (grey, grey + alpha, RGB,
-//! RGBA; 8 bits, 16 bits, 32-bit float) become RGB: grey is replicated, alpha dropped. 8-bit
-//! codes are kept, beside the table of their values (`code / 255` decoded by the
-//! [`TextureEncoding`]); 16-bit codes become linear values the same way (`code / 65535`); float
-//! samples are taken as they are.
+//! RGBA; 8 bits, 16 bits, 32-bit float) become RGB: grey is replicated, alpha dropped. Integer
+//! codes are kept, beside the table of their values (`code / (2^bits − 1)` decoded by the
+//! [`TextureEncoding`]); float samples are taken as they are.
 
 use std::io::Cursor;
 use std::path::Path;
@@ -99,42 +98,38 @@ fn png_header_size(bytes: &[u8]) -> Option<(u32, u32)> {
 
 /// Converts every pixel layout the five codecs produce; `None` for any other.
 fn texels_of(image: DynamicImage, encoding: TextureEncoding) -> Option<Texels> {
-    let values: [f32; 256] = core::array::from_fn(|c| decode(c as f32 / 255.0, encoding));
-    let code16 = |c: u16| decode(f32::from(c) / f32::from(u16::MAX), encoding);
-    let rgb = |p: [f32; 3]| Vec3::from_array(p);
+    let value8 = |c: u8| decode(f32::from(c) / 255.0, encoding);
+    let value16 = |c: u16| decode(f32::from(c) / f32::from(u16::MAX), encoding);
     let linear = |texels: Vec<Vec3>| Some(Texels::Linear(texels));
-    let codes = |codes: Vec<u8>| Some(Texels::codes(codes, values));
-    match image {
-        // 8-bit RGB is kept as decoded, without a copy.
-        DynamicImage::ImageRgb8(b) => codes(b.into_raw()),
-        DynamicImage::ImageLuma8(b) => codes(rgb_codes(&b, 1)),
-        DynamicImage::ImageLumaA8(b) => codes(rgb_codes(&b, 2)),
-        DynamicImage::ImageRgba8(b) => codes(rgb_codes(&b, 4)),
-        DynamicImage::ImageLuma16(b) => {
-            linear(b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect())
-        }
-        DynamicImage::ImageLumaA16(b) => {
-            linear(b.pixels().map(|p| Vec3::splat(code16(p.0[0]))).collect())
-        }
-        DynamicImage::ImageRgb16(b) => linear(b.pixels().map(|p| rgb(p.0.map(code16))).collect()),
-        DynamicImage::ImageRgba16(b) => linear(
-            b.pixels()
-                .map(|p| rgb([p.0[0], p.0[1], p.0[2]].map(code16)))
-                .collect(),
-        ),
+    Some(match image {
+        // RGB is kept as decoded, without a copy.
+        DynamicImage::ImageRgb8(b) => Texels::codes8(b.into_raw(), value8),
+        DynamicImage::ImageLuma8(b) => Texels::codes8(rgb_codes(&b, 1), value8),
+        DynamicImage::ImageLumaA8(b) => Texels::codes8(rgb_codes(&b, 2), value8),
+        DynamicImage::ImageRgba8(b) => Texels::codes8(rgb_codes(&b, 4), value8),
+        DynamicImage::ImageRgb16(b) => Texels::codes16(b.into_raw(), value16),
+        DynamicImage::ImageLuma16(b) => Texels::codes16(rgb_codes(&b, 1), value16),
+        DynamicImage::ImageLumaA16(b) => Texels::codes16(rgb_codes(&b, 2), value16),
+        DynamicImage::ImageRgba16(b) => Texels::codes16(rgb_codes(&b, 4), value16),
         // Floating-point samples (Radiance HDR) are linear values: no encoding applies.
-        DynamicImage::ImageRgb32F(b) => linear(b.pixels().map(|p| rgb(p.0)).collect()),
-        DynamicImage::ImageRgba32F(b) => {
-            linear(b.pixels().map(|p| rgb([p.0[0], p.0[1], p.0[2]])).collect())
+        DynamicImage::ImageRgb32F(b) => {
+            return linear(b.pixels().map(|p| Vec3::from_array(p.0)).collect());
         }
-        _ => None,
-    }
+        DynamicImage::ImageRgba32F(b) => {
+            return linear(
+                b.pixels()
+                    .map(|p| Vec3::new(p.0[0], p.0[1], p.0[2]))
+                    .collect(),
+            );
+        }
+        _ => return None,
+    })
 }
 
 /// Three codes per pixel from pixels of `channels` codes each: grey (one or two channels, the
 /// second alpha) replicated, RGBA's alpha dropped.
-fn rgb_codes(pixels: &[u8], channels: usize) -> Vec<u8> {
-    let rgb = |p: &[u8]| {
+fn rgb_codes<C: Copy>(pixels: &[C], channels: usize) -> Vec<C> {
+    let rgb = |p: &[C]| {
         if channels < 3 {
             [p[0]; 3]
         } else {

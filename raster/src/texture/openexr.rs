@@ -2,7 +2,8 @@
 //!
 //! The first part (layer) of the file is used, at its largest resolution level. Its channels
 //! are chosen by name: `R`, `G`, `B` if all three exist; otherwise `Y` (luminance), or the one
-//! channel of a single-channel part other than `A`, used for all three. Half, float and
+//! channel of a single-channel part other than `A`, used for all three. Half samples are kept
+//! as their 16 bits when all three channels hold them (see `texels`); otherwise half, float and
 //! unsigned-int samples are converted to `f32` by value. Sub-sampled channels are not full-size
 //! images and are not used. Deep data is rejected.
 //!
@@ -14,10 +15,11 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use exr::prelude::{FlatSamples, MetaData, ReadChannels, ReadLayers};
+use exr::prelude::{FlatSamples, MetaData, ReadChannels, ReadLayers, f16};
 use glam::Vec3;
 
 use super::image_formats::Decoded;
+use super::texels::half_value;
 use super::{Texels, TextureError, TextureLimits, TextureSource};
 
 /// Decodes an OpenEXR file held in memory.
@@ -93,11 +95,7 @@ pub(super) fn decode_exr(
         .collect();
     let find = |name: &str| channels.iter().find(|(n, _)| n == name).map(|(_, s)| *s);
     let texels = if let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) {
-        let (r, g, b) = (r.values_as_f32(), g.values_as_f32(), b.values_as_f32());
-        r.zip(g)
-            .zip(b)
-            .map(|((r, g), b)| Vec3::new(r, g, b))
-            .collect()
+        rgb_texels([r, g, b])
     } else {
         let non_alpha: Vec<&(String, &FlatSamples)> =
             channels.iter().filter(|(n, _)| n != "A").collect();
@@ -126,7 +124,30 @@ pub(super) fn decode_exr(
                 ),
             ));
         };
-        grey.values_as_f32().map(Vec3::splat).collect()
+        rgb_texels([grey; 3])
     };
-    Ok((width, height, Texels::Linear(texels)))
+    Ok((width, height, texels))
+}
+
+/// The texels of three full-size channels: 16-bit codes where all three hold half floats
+/// (the usual OpenEXR map; a half's bits index the table of their exact `f32` values), else
+/// 32-bit linear values.
+fn rgb_texels(channels: [&FlatSamples; 3]) -> Texels {
+    if let [
+        FlatSamples::F16(r),
+        FlatSamples::F16(g),
+        FlatSamples::F16(b),
+    ] = channels
+    {
+        let texel = |((r, g), b): ((&f16, &f16), &f16)| [r, g, b].map(|h| h.to_bits());
+        let codes = r.iter().zip(g).zip(b).flat_map(texel).collect();
+        return Texels::codes16(codes, half_value);
+    }
+    let [r, g, b] = channels.map(FlatSamples::values_as_f32);
+    Texels::Linear(
+        r.zip(g)
+            .zip(b)
+            .map(|((r, g), b)| Vec3::new(r, g, b))
+            .collect(),
+    )
 }

@@ -1,57 +1,91 @@
-//! How a texture holds its texels: 8-bit codes beside the 256 values they decode to, or linear
-//! floats.
+//! How a texture holds its texels: 8- or 16-bit codes beside the values they decode to, or
+//! linear floats.
 //!
 //! ```text
-//!   Codes    codes   [r g b][r g b][r g b]…   3 bytes per texel, row-major, top row first
-//!            values  [f32; 256]               code → linear value (sRGB-decoded or code/255)
-//!   Linear   [Vec3][Vec3][Vec3]…              12 bytes per texel
+//!   Codes8    codes   [r g b][r g b]…    3 bytes per texel, row-major, top row first
+//!             values  [f32; 256]         code → linear value (sRGB-decoded or code/255)
+//!   Codes16   codes   [r g b][r g b]…    6 bytes per texel (u16 codes)
+//!             values  [f32; 65 536]      code → linear value (sRGB-decoded or code/65535 for
+//!                                        16-bit files; the half float's value for OpenEXR)
+//!   Linear    [Vec3][Vec3]…              12 bytes per texel
 //! ```
 //!
 //! Most textures are 8-bit files (PNG, JPEG, TGA, BMP), and those keep their codes: an
-//! 8192 × 8192 colour map takes 192 MiB instead of the 768 MiB of its linear values. A texel
-//! reads the same `f32`s either way (the table holds exactly what decoding each code gives), so
-//! lookups, and every image rendered with them, have the same bits whichever form a texture
-//! takes. 16-bit and floating-point files (and textures made in code) are linear.
+//! 8192 × 8192 colour map takes 192 MiB instead of the 768 MiB of its linear values; 16-bit
+//! files and half-float OpenEXR maps (a half's 16 bits are a code like any other, its table
+//! the exact conversion to `f32`) take half of that. A texel reads the same `f32`s in every
+//! form (a table holds exactly what decoding each code gives), so lookups, and every image
+//! rendered with them, have the same bits whichever form a texture takes. 32-bit float files (Radiance HDR, float OpenEXR) and
+//! textures made in code are linear.
 
+use exr::prelude::f16;
 use glam::Vec3;
 
 /// The texels of a texture (see the module's layout).
 #[derive(Clone, Debug, PartialEq)]
 pub(super) enum Texels {
     /// 8-bit codes, three per texel, and the linear value of each code.
-    Codes {
+    Codes8 {
         /// R, G, B codes of each texel in turn.
         codes: Vec<u8>,
         /// The linear value of each code.
         values: Box<[f32; 256]>,
+    },
+    /// 16-bit codes, three per texel, and the linear value of each code (65 536 of them).
+    Codes16 {
+        /// R, G, B codes of each texel in turn.
+        codes: Vec<u16>,
+        /// The linear value of each code.
+        values: Box<[f32; 65_536]>,
     },
     /// Linear values.
     Linear(Vec<Vec3>),
 }
 
 const _: () = assert!(size_of::<[u8; 3]>() * 4 == size_of::<Vec3>());
+const _: () = assert!(size_of::<[u16; 3]>() * 2 == size_of::<Vec3>());
 
 impl Texels {
-    /// 8-bit RGB codes (three bytes per texel) decoded through `values`.
-    pub(super) fn codes(codes: Vec<u8>, values: [f32; 256]) -> Texels {
-        Texels::Codes {
+    /// 8-bit RGB codes (three per texel), each code's value given by `value`.
+    pub(super) fn codes8(codes: Vec<u8>, value: impl Fn(u8) -> f32) -> Texels {
+        Texels::Codes8 {
             codes,
-            values: Box::new(values),
+            values: Box::new(core::array::from_fn(|c| value(c as u8))),
+        }
+    }
+
+    /// 16-bit RGB codes (three per texel), each code's value given by `value`.
+    pub(super) fn codes16(codes: Vec<u16>, value: impl Fn(u16) -> f32) -> Texels {
+        Texels::Codes16 {
+            codes,
+            values: {
+                let mut values = Box::new([0.0; 65_536]);
+                for (c, v) in (0..=u16::MAX).zip(values.iter_mut()) {
+                    *v = value(c);
+                }
+                values
+            },
         }
     }
 
     /// The number of texels held.
     pub(super) fn len(&self) -> usize {
         match self {
-            Texels::Codes { codes, .. } => codes.len() / 3,
+            Texels::Codes8 { codes, .. } => codes.len() / 3,
+            Texels::Codes16 { codes, .. } => codes.len() / 3,
             Texels::Linear(texels) => texels.len(),
         }
     }
 
-    /// Bytes of texel data.
+    /// Bytes of texel data, code tables included.
     pub(super) fn bytes(&self) -> usize {
         match self {
-            Texels::Codes { codes, values } => codes.len() + size_of_val(&**values),
+            Texels::Codes8 { codes, values } => {
+                size_of_val(codes.as_slice()) + size_of_val(&**values)
+            }
+            Texels::Codes16 { codes, values } => {
+                size_of_val(codes.as_slice()) + size_of_val(&**values)
+            }
             Texels::Linear(texels) => size_of_val(texels.as_slice()),
         }
     }
@@ -60,16 +94,19 @@ impl Texels {
     #[inline]
     pub(super) fn get(&self, index: usize) -> Vec3 {
         match self {
-            Texels::Codes { codes, values } => decode(codes, values, index),
+            Texels::Codes8 { codes, values } => coded(codes, values, index),
+            Texels::Codes16 { codes, values } => coded(codes, values, index),
             Texels::Linear(texels) => texels[index],
         }
     }
 
     /// The index of the first texel that is not finite, if any.
     pub(super) fn first_non_finite(&self) -> Option<usize> {
+        let finite = |values: &[f32]| values.iter().all(|v| v.is_finite());
         match self {
             // Every texel is one of the table's values.
-            Texels::Codes { values, .. } if values.iter().all(|v| v.is_finite()) => None,
+            Texels::Codes8 { values, .. } if finite(&**values) => None,
+            Texels::Codes16 { values, .. } if finite(&**values) => None,
             _ => (0..self.len()).find(|&i| !self.get(i).is_finite()),
         }
     }
@@ -80,10 +117,16 @@ impl Texels {
     #[inline]
     pub(super) fn blend(&self, at: [usize; 4], fx: f32, fy: f32) -> Vec3 {
         match self {
-            Texels::Codes { codes, values } => bilinear(|i| decode(codes, values, i), at, fx, fy),
+            Texels::Codes8 { codes, values } => bilinear(|i| coded(codes, values, i), at, fx, fy),
+            Texels::Codes16 { codes, values } => bilinear(|i| coded(codes, values, i), at, fx, fy),
             Texels::Linear(texels) => bilinear(|i| texels[i], at, fx, fy),
         }
     }
+}
+
+/// The value of a half float's bits (exact): the code table of a half-float map.
+pub(super) fn half_value(bits: u16) -> f32 {
+    f16::from_bits(bits).to_f32()
 }
 
 /// The bilinear blend of the texels `texel` reads at `[row0, row1, x0, x1]`.
@@ -95,89 +138,151 @@ fn bilinear(texel: impl Fn(usize) -> Vec3, at: [usize; 4], fx: f32, fy: f32) -> 
     top.lerp(bottom, fy)
 }
 
-/// Texel `index` of three-byte codes, decoded.
+/// Texel `index` of three codes a texel, each decoded through `values`. One bounds check: a
+/// code cannot index a table of all its values out of range.
 #[inline]
-fn decode(codes: &[u8], values: &[f32; 256], index: usize) -> Vec3 {
-    let [r, g, b] = [codes[3 * index], codes[3 * index + 1], codes[3 * index + 2]];
-    Vec3::new(
-        values[usize::from(r)],
-        values[usize::from(g)],
-        values[usize::from(b)],
-    )
+fn coded<C: Copy, const N: usize>(codes: &[C], values: &[f32; N], index: usize) -> Vec3
+where
+    usize: From<C>,
+{
+    let at = 3 * index;
+    let &[r, g, b] = &codes[at..at + 3] else {
+        unreachable!("a range of three codes")
+    };
+    let value = |c: C| values[usize::from(c)];
+    Vec3::new(value(r), value(g), value(b))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A code table that is not the identity, so a texel read through the wrong index shows.
-    fn table() -> [f32; 256] {
-        core::array::from_fn(|c| (c as f32 / 255.0).powi(2) + 0.001 * c as f32)
+    /// Texels of a 4 × 3 image.
+    const N: usize = 12;
+
+    /// Code tables that are not the identity, so a texel read through the wrong index shows.
+    fn value8(c: u8) -> f32 {
+        (f32::from(c) / 255.0).powi(2) + 0.001 * f32::from(c)
+    }
+    fn value16(c: u16) -> f32 {
+        (f32::from(c) / 65535.0).powf(2.2)
     }
 
-    /// Codes and the linear texels they decode to give the same value at every texel and the
-    /// same bits in every blend.
-    #[test]
-    fn codes_read_as_their_linear_values() {
-        let values = table();
-        let codes: Vec<u8> = (0..4 * 3 * 3).map(|i| (i * 37 % 256) as u8).collect();
-        let linear: Vec<Vec3> = codes
-            .chunks_exact(3)
-            .map(|c| {
-                Vec3::new(
-                    values[c[0] as usize],
-                    values[c[1] as usize],
-                    values[c[2] as usize],
-                )
-            })
+    /// Each compact form with the linear values its texels decode to.
+    fn forms() -> Vec<(&'static str, Texels, Vec<Vec3>)> {
+        let rgb = |v: Vec<f32>| -> Vec<Vec3> { v.chunks_exact(3).map(Vec3::from_slice).collect() };
+        let codes8: Vec<u8> = (0..3 * N).map(|i| (i * 37 % 256) as u8).collect();
+        let codes16: Vec<u16> = (0..3 * N).map(|i| (i * 7919 % 65536) as u16).collect();
+        // Normal, subnormal, negative, zero and the largest finite halves, as their bits.
+        let halves: Vec<u16> = (0..3 * N)
+            .map(|i| f16::from_f32(i as f32 * 0.37 - 1.5))
+            .chain([6.0e-8, -0.0, 65504.0].map(f16::from_f32))
+            .skip(3)
+            .map(f16::to_bits)
             .collect();
-        let (a, b) = (Texels::codes(codes, values), Texels::Linear(linear.clone()));
-        assert_eq!(a.len(), 12);
-        assert_eq!(b.len(), 12);
-        for (i, &want) in linear.iter().enumerate() {
-            assert_eq!(a.get(i), want, "texel {i}");
-            assert_eq!(b.get(i), want, "texel {i}");
-        }
-        // A 4-wide, 3-high image: every footprint, at uneven weights.
-        for (row0, row1) in [(0, 4), (4, 8), (8, 0)] {
-            for (x0, x1) in [(0, 1), (2, 3), (3, 0)] {
-                for (fx, fy) in [(0.0, 0.0), (0.3, 0.71), (1.0, 0.5)] {
-                    let at = [row0, row1, x0, x1];
-                    let want = {
-                        let t = |i: usize| linear[i];
-                        let top = t(row0 + x0).lerp(t(row0 + x1), fx);
-                        top.lerp(t(row1 + x0).lerp(t(row1 + x1), fx), fy)
-                    };
-                    assert_eq!(a.blend(at, fx, fy), want);
-                    assert_eq!(b.blend(at, fx, fy), want);
+        vec![
+            (
+                "codes8",
+                Texels::codes8(codes8.clone(), value8),
+                rgb(codes8.iter().map(|&c| value8(c)).collect()),
+            ),
+            (
+                "codes16",
+                Texels::codes16(codes16.clone(), value16),
+                rgb(codes16.iter().map(|&c| value16(c)).collect()),
+            ),
+            (
+                "half",
+                Texels::codes16(halves.clone(), half_value),
+                rgb(halves.iter().map(|&h| f16::from_bits(h).to_f32()).collect()),
+            ),
+        ]
+    }
+
+    /// Every form reads the linear values its texels decode to, bit for bit, one texel at a
+    /// time and in every bilinear blend.
+    #[test]
+    fn every_form_reads_as_its_linear_values() {
+        for (name, texels, linear) in forms() {
+            assert_eq!(linear.len(), N, "{name}");
+            assert_eq!(texels.len(), N, "{name}");
+            for (i, &want) in linear.iter().enumerate() {
+                assert_eq!(
+                    texels.get(i).to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits),
+                    "{name} texel {i}"
+                );
+            }
+            let as_linear = Texels::Linear(linear.clone());
+            for (row0, row1) in [(0, 4), (4, 8), (8, 0)] {
+                for (x0, x1) in [(0, 1), (2, 3), (3, 0)] {
+                    for (fx, fy) in [(0.0, 0.0), (0.3, 0.71), (1.0, 0.5)] {
+                        let at = [row0, row1, x0, x1];
+                        let want = {
+                            let t = |i: usize| linear[i];
+                            let top = t(row0 + x0).lerp(t(row0 + x1), fx);
+                            top.lerp(t(row1 + x0).lerp(t(row1 + x1), fx), fy)
+                        };
+                        assert_eq!(texels.blend(at, fx, fy), want, "{name} {at:?}");
+                        assert_eq!(as_linear.blend(at, fx, fy), want, "{name} {at:?}");
+                    }
                 }
             }
         }
     }
 
-    /// Codes take three bytes a texel (and the table); linear values twelve.
+    /// 8-bit codes take 3 bytes a texel and a 1 KiB table; 16-bit codes and halves 6 and
+    /// 256 KiB; linear values 12.
     #[test]
-    fn codes_take_a_quarter_of_the_memory() {
-        let n = 1000;
-        let codes = Texels::codes(vec![7; 3 * n], table());
-        let linear = Texels::Linear(vec![Vec3::ONE; n]);
-        assert_eq!(codes.bytes(), 3 * n + 1024);
-        assert_eq!(linear.bytes(), 12 * n);
+    fn each_form_takes_its_share_of_memory() {
+        let bytes: Vec<(&str, usize)> = forms().iter().map(|(n, t, _)| (*n, t.bytes())).collect();
+        assert_eq!(
+            bytes,
+            [
+                ("codes8", 3 * N + 1024),
+                ("codes16", 6 * N + 262_144),
+                ("half", 6 * N + 262_144)
+            ]
+        );
+        assert_eq!(Texels::Linear(vec![Vec3::ONE; N]).bytes(), 12 * N);
     }
 
-    /// A table with a non-finite value reports the first texel that uses it; a finite table
-    /// needs no scan.
+    /// A table with a non-finite value (a half's infinity or NaN among them) reports the first
+    /// texel that uses it (a finite table needs no scan); linear values are scanned.
     #[test]
-    fn non_finite_texels_are_found_in_either_form() {
-        let mut values = table();
+    fn non_finite_texels_are_found_in_every_form() {
+        let codes = vec![0, 1, 2, 3, 4, 5];
         assert_eq!(
-            Texels::codes(vec![0, 1, 2, 3, 4, 5], values).first_non_finite(),
+            Texels::codes8(codes.clone(), value8).first_non_finite(),
             None
         );
-        values[4] = f32::NAN;
+        let nan_at_4 = |c: u8| if c == 4 { f32::NAN } else { value8(c) };
         assert_eq!(
-            Texels::codes(vec![0, 1, 2, 3, 4, 5], values).first_non_finite(),
+            Texels::codes8(codes.clone(), nan_at_4).first_non_finite(),
             Some(1)
+        );
+        let codes16 = codes
+            .iter()
+            .map(|&c| u16::from(c) * 300)
+            .collect::<Vec<_>>();
+        let inf_at_1500 = |c: u16| if c == 1500 { f32::INFINITY } else { value16(c) };
+        assert_eq!(
+            Texels::codes16(codes16.clone(), value16).first_non_finite(),
+            None
+        );
+        assert_eq!(
+            Texels::codes16(codes16, inf_at_1500).first_non_finite(),
+            Some(1)
+        );
+        let mut halves = vec![f16::ONE.to_bits(); 9];
+        assert_eq!(
+            Texels::codes16(halves.clone(), half_value).first_non_finite(),
+            None
+        );
+        halves[7] = f16::NAN.to_bits();
+        assert_eq!(
+            Texels::codes16(halves, half_value).first_non_finite(),
+            Some(2)
         );
         let linear = Texels::Linear(vec![
             Vec3::ONE,

@@ -475,8 +475,8 @@ fn oversized_headers_are_rejected_before_decoding() {
 }
 
 /// A texture past 4096² (4608 × 4608 grey, 21 M texels, more than 2²⁴) loads with the default
-/// caps and reads exactly, its 8-bit codes held at three bytes a texel; 16-bit files are held
-/// as linear floats.
+/// caps and reads exactly, its 8-bit codes held at three bytes a texel; 16-bit codes and
+/// half-float OpenEXR maps take six, 32-bit floats twelve.
 #[test]
 fn eight_bit_textures_beyond_4096_squared_load_as_codes() {
     let (w, h) = (4608u32, 4608u32);
@@ -527,8 +527,21 @@ fn eight_bit_textures_beyond_4096_squared_load_as_codes() {
     );
     assert_eq!(
         ok(&grey16, "g16.png", TextureEncoding::Linear).texel_bytes(),
-        2 * 12
+        2 * 6 + 65_536 * 4
     );
+    // OpenEXR: halves stay 16 bits when all three channels hold them.
+    let halves = |v: [f32; 2]| FlatSamples::F16(v.map(f16::from_f32).to_vec());
+    let rgb = |r, g, b| exr_channels(2, 1, vec![("R", r), ("G", g), ("B", b)]);
+    let exr_bytes = |file: Vec<u8>| ok(&file, "m.exr", TextureEncoding::Linear).texel_bytes();
+    let (one, two) = ([0.5, 1.0], [2.0, 4.0]);
+    assert_eq!(
+        exr_bytes(rgb(halves(one), halves(two), halves(one))),
+        2 * 6 + 65_536 * 4
+    );
+    let floats = FlatSamples::F32(two.to_vec());
+    assert_eq!(exr_bytes(rgb(halves(one), floats, halves(one))), 2 * 12);
+    let grey = exr_channels(2, 1, vec![("Y", halves(two))]);
+    assert_eq!(exr_bytes(grey), 2 * 6 + 65_536 * 4);
 }
 
 /// A tile size far beyond the image is refused from the header: the decoder would allocate a
