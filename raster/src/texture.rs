@@ -46,7 +46,8 @@ pub const MAX_TEXTURE_SIDE: u32 = 16_384;
 /// as linear values).
 pub const MAX_TEXTURE_TEXELS: u64 = 1 << 26;
 
-/// A decoded RGB texture with linear values.
+/// A decoded RGB texture, read as linear values (held as its file's codes where it has them:
+/// see `texels`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
     /// Where it was loaded from.
