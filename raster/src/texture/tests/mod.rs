@@ -165,6 +165,21 @@ fn decodes_grey16_palette_and_rgba() {
         Texture::from_bytes(&png, Path::new("g.png"), TextureEncoding::Linear).expect("decodes");
     assert!(close(t.texel(0), Vec3::splat(32768.0 / 65535.0), 1e-7));
     assert!(close(t.texel(1), Vec3::ONE, 0.0));
+    // 16-bit RGB and RGBA, big endian, each channel its own code; sRGB-decoded, exactly.
+    let codes: [u16; 6] = [0x0102, 0x8000, 0xfffe, 0x0000, 0x1234, 0xffff];
+    let srgb = |c: u16| srgb_to_linear(f32::from(c) / 65535.0);
+    let want = [0, 3].map(|i| Vec3::new(srgb(codes[i]), srgb(codes[i + 1]), srgb(codes[i + 2])));
+    let be: Vec<u8> = codes.iter().flat_map(|c| c.to_be_bytes()).collect();
+    let alpha: Vec<u8> = be
+        .chunks_exact(6)
+        .flat_map(|p| p.iter().copied().chain([0x55, 0xaa]))
+        .collect();
+    for (colour, data) in [(png::ColorType::Rgb, be), (png::ColorType::Rgba, alpha)] {
+        let png = encode_png(2, 1, colour, png::BitDepth::Sixteen, &data, None);
+        let t =
+            Texture::from_bytes(&png, Path::new("c.png"), TextureEncoding::Srgb).expect("decodes");
+        assert_eq!([t.texel(0), t.texel(1)], want, "{colour:?}");
+    }
     // 1-bit grey, 3 × 1: bits 1 0 1 (row padded to a byte).
     let png = encode_png(
         3,
