@@ -23,7 +23,9 @@ pub enum RasterError {
         /// The requested value.
         aa: u32,
     },
-    /// The window of a [`VisibilityBuffer::new_window`](super::VisibilityBuffer::new_window) is empty or not inside the image.
+    /// The window of a
+    /// [`VisibilityBuffer::new_window`](super::VisibilityBuffer::new_window) is empty or not
+    /// inside the image.
     WindowOutside {
         /// The requested window.
         window: Region,

@@ -15,8 +15,8 @@
 //! files and half-float OpenEXR maps (a half's 16 bits are a code like any other, its table
 //! the exact conversion to `f32`) take half of that. A texel reads the same `f32`s in every
 //! form (a table holds exactly what decoding each code gives), so lookups, and every image
-//! rendered with them, have the same bits whichever form a texture takes. 32-bit float files (Radiance HDR, float OpenEXR) and
-//! textures made in code are linear.
+//! rendered with them, have the same bits whichever form a texture takes. 32-bit float files
+//! (Radiance HDR, float OpenEXR) and textures made in code are linear.
 
 use exr::prelude::f16;
 use glam::Vec3;
@@ -58,13 +58,12 @@ impl Texels {
     pub(super) fn codes16(codes: Vec<u16>, value: impl Fn(u16) -> f32) -> Texels {
         Texels::Codes16 {
             codes,
-            values: {
-                let mut values = Box::new([0.0; 65_536]);
-                for (c, v) in (0..=u16::MAX).zip(values.iter_mut()) {
-                    *v = value(c);
-                }
-                values
-            },
+            // Made on the heap: the table is 256 KiB.
+            values: (0..=u16::MAX)
+                .map(value)
+                .collect::<Box<[f32]>>()
+                .try_into()
+                .unwrap_or_else(|_| unreachable!("one value per 16-bit code")),
         }
     }
 
