@@ -23,6 +23,7 @@
 //! | PNG, JPEG, TGA, BMP, HDR (`image` crate) | `image_formats` |
 //! | OpenEXR (`exr` crate) | `openexr` |
 //! | the texels in memory: 8-bit codes or linear values | `texels` |
+//! | UDIM sets: one image per unit square of UV space | `udim` |
 //! | errors | `error` |
 
 use std::path::{Path, PathBuf};
@@ -34,10 +35,13 @@ mod format;
 mod image_formats;
 mod openexr;
 mod texels;
+mod udim;
 
 pub use error::{TextureError, TextureSource};
 pub use format::TextureFormat;
 use texels::Texels;
+use udim::Udim;
+pub use udim::{FIRST_TILE, LAST_TILE, MAX_UDIM_TEXELS, UDIM_TOKEN, tile_of};
 
 /// Largest accepted texture width or height, in texels.
 pub const MAX_TEXTURE_SIDE: u32 = 16_384;
@@ -58,6 +62,8 @@ pub struct Texture {
     pub height: u32,
     /// Row-major texels, top row first: 8-bit codes or linear RGB.
     texels: Texels,
+    /// The tiles of a UDIM set, whose own size is 0 × 0 with no texels; `None` for one image.
+    udim: Option<Box<Udim>>,
 }
 
 /// How the integer values stored in a file map to the texture's linear values. Floating-point
@@ -125,27 +131,66 @@ impl Texture {
             width,
             height,
             texels: Texels::Linear(texels),
+            udim: None,
         }
     }
 
-    /// The linear value of texel `index` (row-major, top row first). Panics past the last.
+    /// The UDIM set of `tiles` (tile number, image), named `path` (the pattern); `None` if a
+    /// tile number is outside 1001…1100 or repeated.
+    pub fn udim(path: impl Into<PathBuf>, tiles: Vec<(u32, Texture)>) -> Option<Self> {
+        Some(Texture {
+            path: path.into(),
+            width: 0,
+            height: 0,
+            texels: Texels::Linear(Vec::new()),
+            udim: Some(Box::new(Udim::new(tiles)?)),
+        })
+    }
+
+    /// Whether this is a UDIM set.
+    pub fn is_udim(&self) -> bool {
+        self.udim.is_some()
+    }
+
+    /// The images holding the texels: a UDIM set's tiles in increasing tile number, or this
+    /// texture alone.
+    fn images(&self) -> &[Texture] {
+        match &self.udim {
+            Some(set) => set.tiles(),
+            None => std::slice::from_ref(self),
+        }
+    }
+
+    /// The linear value of texel `index` (row-major, top row first; a UDIM set's tiles one
+    /// after the other). Panics past the last.
     pub fn texel(&self, index: usize) -> Vec3 {
-        self.texels.get(index)
+        let mut index = index;
+        for image in self.images() {
+            match index.checked_sub(image.texels.len()) {
+                Some(rest) => index = rest,
+                None => return image.texels.get(index),
+            }
+        }
+        panic!("texel {index} past the last of {}", self.path.display())
     }
 
-    /// The linear values of every texel, row-major, top row first.
-    pub fn texels(&self) -> impl ExactSizeIterator<Item = Vec3> + '_ {
-        (0..self.texels.len()).map(|i| self.texels.get(i))
+    /// The linear values of every texel, row-major, top row first (a UDIM set's tiles in
+    /// increasing tile number).
+    pub fn texels(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.images()
+            .iter()
+            .flat_map(|image| (0..image.texels.len()).map(|i| image.texels.get(i)))
     }
 
-    /// The number of texels held.
+    /// The number of texels held (in all the tiles of a UDIM set).
     pub fn texel_count(&self) -> usize {
-        self.texels.len()
+        self.images().iter().map(|image| image.texels.len()).sum()
     }
 
-    /// The bytes its texels take: 3 per texel for 8-bit files, 12 for the others.
+    /// The bytes its texels take: 3 per texel for 8-bit files, 6 for 16-bit and half-float
+    /// ones, 12 for 32-bit floats (and the code tables).
     pub fn texel_bytes(&self) -> usize {
-        self.texels.bytes()
+        self.images().iter().map(|image| image.texels.bytes()).sum()
     }
 
     /// Bilinear lookup with repeat wrapping. `uv = (0, 0)` is the bottom-left corner of the
@@ -153,8 +198,12 @@ impl Texture {
     ///
     /// Texel centres sit at half-integer positions: texel column `i`, row `j` (from the top) is
     /// returned exactly at `uv = ((i + ½)/width, 1 − (j + ½)/height)`. Non-finite coordinates
-    /// are treated as 0. An empty (or inconsistent) texture samples as black.
+    /// are treated as 0. An empty (or inconsistent) texture samples as black. A UDIM set
+    /// samples the tile that `uv` falls in (see `udim`).
     pub fn sample(&self, uv: Vec2) -> Vec3 {
+        if let Some(set) = &self.udim {
+            return set.sample(uv);
+        }
         match self.footprint(uv) {
             Some(at) => self.sample_at(&at),
             None => Vec3::ZERO,
@@ -165,6 +214,9 @@ impl Texture {
     /// texels and weights are found once (a material's K_d and radius maps usually share a
     /// resolution).
     pub fn sample_pair(a: &Texture, b: &Texture, uv: Vec2) -> (Vec3, Vec3) {
+        if a.is_udim() {
+            return (a.sample(uv), b.sample(uv));
+        }
         let Some(at) = a.footprint(uv) else {
             return (Vec3::ZERO, b.sample(uv));
         };
@@ -270,6 +322,7 @@ impl Texture {
             width,
             height,
             texels,
+            udim: None,
         })
     }
 

@@ -73,6 +73,9 @@ impl EnvironmentMap {
     /// The map of `texture` and its distribution. Errors (as a message) if a texel is negative
     /// or not finite, or if the map is empty; an all-black map is valid and delivers no light.
     pub fn new(texture: Arc<Texture>) -> Result<EnvironmentMap, String> {
+        if texture.is_udim() {
+            return Err("a UDIM set is not a latitude-longitude map: give one image".to_string());
+        }
         let (w, h) = (texture.width as usize, texture.height as usize);
         if w == 0 || h == 0 || texture.texel_count() != w * h {
             return Err(format!(

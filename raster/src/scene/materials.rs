@@ -22,7 +22,9 @@ use super::model::{
     ColorParam, Distance, Material, Medium, ScalarParam, Specular, TranslucentMaterial,
 };
 use super::origin::SceneOrigin;
-use crate::texture::{Texture, TextureEncoding};
+use crate::texture::{
+    FIRST_TILE, LAST_TILE, MAX_UDIM_TEXELS, Texture, TextureEncoding, UDIM_TOKEN,
+};
 
 /// The names accepted by `preset` (matched case-insensitively): the measured materials of
 /// Jensen et al. 2001 in `lucent_core::presets`, the one list.
@@ -42,6 +44,8 @@ const MATERIAL_TYPES: [&str; 2] = ["translucent", "lambert"];
 pub(crate) struct TextureCache<'o> {
     origin: &'o SceneOrigin,
     loaded: HashMap<(String, TextureEncoding), Arc<Texture>>,
+    /// Most texels in all the tiles of a UDIM set ([`MAX_UDIM_TEXELS`]).
+    udim_texel_cap: u64,
 }
 
 impl<'o> TextureCache<'o> {
@@ -50,6 +54,7 @@ impl<'o> TextureCache<'o> {
         TextureCache {
             origin,
             loaded: HashMap::new(),
+            udim_texel_cap: MAX_UDIM_TEXELS,
         }
     }
 
@@ -66,8 +71,28 @@ impl<'o> TextureCache<'o> {
         if let Some(t) = self.loaded.get(&(name.clone(), encoding)) {
             return Ok(Arc::clone(t));
         }
-        let path = self.origin.resolve(&name);
-        let bytes = self.origin.read(&name).map_err(|why| {
+        let texture = if name.contains(UDIM_TOKEN) {
+            self.udim(c, key, file, encoding)?
+        } else {
+            self.one(c, key, file, &name, encoding)?
+        };
+        let texture = Arc::new(texture);
+        self.loaded.insert((name, encoding), Arc::clone(&texture));
+        Ok(texture)
+    }
+
+    /// The image in the scene-relative file `name`, decoded with `encoding`; errors located at
+    /// `file` under `key`.
+    fn one(
+        &self,
+        c: &Check,
+        key: &str,
+        file: &Spanned<String>,
+        name: &str,
+        encoding: TextureEncoding,
+    ) -> Checked<Texture> {
+        let path = self.origin.resolve(name);
+        let bytes = self.origin.read(name).map_err(|why| {
             c.at(
                 SceneErrorKind::Io,
                 key,
@@ -76,13 +101,65 @@ impl<'o> TextureCache<'o> {
             )
             .with_source(why)
         })?;
-        let texture = Texture::from_bytes(&bytes, &path, encoding).map_err(|e| {
+        Texture::from_bytes(&bytes, &path, encoding).map_err(|e| {
             c.at(SceneErrorKind::Texture, key, file, e.to_string())
                 .with_source(e)
+        })
+    }
+
+    /// The UDIM set `file` names (its file name holds `<UDIM>`): every tile file found,
+    /// decoded with `encoding`, at most [`MAX_UDIM_TEXELS`] texels in all (each tile within
+    /// its own cap first).
+    fn udim(
+        &self,
+        c: &Check,
+        key: &str,
+        file: &Spanned<String>,
+        encoding: TextureEncoding,
+    ) -> Checked<Texture> {
+        let pattern = file.get_ref();
+        let path = self.origin.resolve(pattern);
+        let fail = |kind, message: String| c.at(kind, key, file, message);
+        let names = self.origin.udim_tiles(pattern).map_err(|why| {
+            fail(
+                SceneErrorKind::Io,
+                format!("cannot list the UDIM tiles {}: {why}", path.display()),
+            )
+            .with_source(why)
         })?;
-        let texture = Arc::new(texture);
-        self.loaded.insert((name, encoding), Arc::clone(&texture));
-        Ok(texture)
+        if names.is_empty() {
+            return Err(fail(
+                SceneErrorKind::Io,
+                format!(
+                    "no file matches the UDIM set {} (tiles {FIRST_TILE} to {LAST_TILE})",
+                    path.display(),
+                ),
+            ));
+        }
+        let mut tiles = Vec::with_capacity(names.len());
+        let mut texels = 0u64;
+        for (tile, name) in names {
+            let texture = self.one(c, key, file, &name, encoding)?;
+            texels += texture.texel_count() as u64;
+            if texels > self.udim_texel_cap {
+                return Err(fail(
+                    SceneErrorKind::Texture,
+                    format!(
+                        "UDIM set {}: more than {} texels in all (up to tile {tile})",
+                        path.display(),
+                        self.udim_texel_cap
+                    ),
+                ));
+            }
+            tiles.push((tile, texture));
+        }
+        // The tile numbers come from the file names, each once: they are valid.
+        Texture::udim(path.clone(), tiles).ok_or_else(|| {
+            fail(
+                SceneErrorKind::Texture,
+                format!("UDIM set {}: invalid tile numbers", path.display()),
+            )
+        })
     }
 }
 
@@ -601,4 +678,64 @@ fn distance_param(
 fn forbid_range(c: &Check, key: &str, t: &RawTextureRef, what: &str) -> Checked<()> {
     c.forbid(&format!("{key}.min"), &t.min, what)?;
     c.forbid(&format!("{key}.max"), &t.max, what)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::error::Source;
+    use super::*;
+    use crate::texture::tests::encode_png;
+
+    /// A UDIM set among a built-in scene's files (listed like a folder's): its tiles load,
+    /// other files beside them are not tiles, and tiles holding more texels together than the
+    /// cap are refused, naming the tile that crossed it.
+    #[test]
+    fn udim_sets_load_their_tiles_within_the_cap() {
+        let tile = |grey: u8| {
+            let png = encode_png(
+                2,
+                2,
+                png::ColorType::Grayscale,
+                png::BitDepth::Eight,
+                &[grey; 4],
+                None,
+            );
+            std::borrow::Cow::Owned(png)
+        };
+        let origin = SceneOrigin::Embedded {
+            name: "<test>/scene.toml".to_string(),
+            files: vec![
+                ("t/kd.1002.png".to_string(), tile(200)),
+                ("t/kd.1001.png".to_string(), tile(100)),
+                ("t/kd.png".to_string(), tile(0)),
+                ("kd.1003.png".to_string(), tile(0)),
+            ],
+        };
+        let c = Check {
+            src: Source {
+                file: "scene.toml",
+                text: "kd",
+            },
+        };
+        let file = Spanned::new(0..2, "t/kd.<UDIM>.png".to_string());
+        let mut cache = TextureCache::new(&origin);
+        cache.udim_texel_cap = 7;
+        let e = cache
+            .get(&c, "k", &file, TextureEncoding::Linear)
+            .expect_err("8 texels > 7");
+        assert!(
+            e.message
+                .ends_with("kd.<UDIM>.png: more than 7 texels in all (up to tile 1002)"),
+            "{}",
+            e.message
+        );
+        cache.udim_texel_cap = 8;
+        let set = cache
+            .get(&c, "k", &file, TextureEncoding::Linear)
+            .expect("8 texels");
+        assert!(set.is_udim());
+        let grey = |code: f32| Vec3::splat(code / 255.0);
+        let want = [[grey(100.0); 4], [grey(200.0); 4]].concat();
+        assert_eq!(set.texels().collect::<Vec<_>>(), want);
+    }
 }

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use crate::memory;
+use crate::texture::{UDIM_TOKEN, tile_of};
 
 /// Largest file the loader reads (scene, material library, texture, baked samples): 1 GiB.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
@@ -103,6 +104,61 @@ impl SceneOrigin {
                     })
             }
         }
+    }
+}
+
+impl SceneOrigin {
+    /// The files of the UDIM set `pattern` (a scene-relative path whose file name holds
+    /// [`UDIM_TOKEN`]): each tile number with the file's scene-relative path, in increasing
+    /// tile number. Errors if the token is not in the file name or the folder cannot be listed.
+    pub fn udim_tiles(&self, pattern: &str) -> Result<Vec<(u32, String)>, std::io::Error> {
+        let (folder, name) = match pattern.rsplit_once('/') {
+            Some((folder, name)) => (Some(folder), name),
+            None => (None, pattern),
+        };
+        if !name.contains(UDIM_TOKEN) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("{UDIM_TOKEN} must be in the file name, not in a folder"),
+            ));
+        }
+        let relative = |file: &str| match folder {
+            Some(folder) => format!("{folder}/{file}"),
+            None => file.to_string(),
+        };
+        let names: Vec<String> = match self {
+            SceneOrigin::File(_) => {
+                let dir = self.resolve(folder.unwrap_or("."));
+                let mut names = Vec::new();
+                for entry in std::fs::read_dir(&dir)? {
+                    let entry = entry?;
+                    if let Some(file) = entry.file_name().to_str() {
+                        names.push(file.to_string());
+                    }
+                }
+                names
+            }
+            SceneOrigin::Embedded { files, .. } => {
+                let folder = folder.map(normalise);
+                files
+                    .iter()
+                    .filter_map(|(file, _)| {
+                        let file = normalise(file);
+                        match (file.rsplit_once('/'), folder) {
+                            (Some((f, n)), Some(wanted)) if f == wanted => Some(n.to_string()),
+                            (None, None) => Some(file.to_string()),
+                            _ => None,
+                        }
+                    })
+                    .collect()
+            }
+        };
+        let mut tiles: Vec<(u32, String)> = names
+            .iter()
+            .filter_map(|file| Some((tile_of(name, file)?, relative(file))))
+            .collect();
+        tiles.sort();
+        Ok(tiles)
     }
 }
 

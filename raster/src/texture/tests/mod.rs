@@ -378,3 +378,35 @@ fn floor_matches_the_standard_library() {
         assert_eq!(floor(x), x.floor(), "{x}");
     }
 }
+
+/// A UDIM set holds its tiles' texels one tile after the other, in tile order, and samples
+/// alone or in a pair with another texture of either kind.
+#[test]
+fn a_udim_set_holds_its_tiles_and_samples_in_pairs() {
+    let a = texture(1, 1, vec![Vec3::X]);
+    let b = texture(2, 1, vec![Vec3::Y, Vec3::Z]);
+    let set = Texture::udim("s.<UDIM>.png", vec![(1002, b.clone()), (1001, a.clone())])
+        .expect("valid tiles");
+    assert!(set.is_udim() && !a.is_udim());
+    assert_eq!(set.texel_count(), 3);
+    assert_eq!(
+        set.texels().collect::<Vec<_>>(),
+        [Vec3::X, Vec3::Y, Vec3::Z]
+    );
+    assert_eq!(set.texel(2), Vec3::Z);
+    assert_eq!(set.texel_bytes(), 3 * 12);
+    let uv = Vec2::new(1.3, 0.5);
+    let in_tile = uv - Vec2::X; // what the set samples its tile 1002 at
+    assert_ne!(b.sample(uv), b.sample(Vec2::new(0.7, 0.5)));
+    assert_eq!(set.sample(uv), b.sample(in_tile));
+    assert_eq!(set.sample(Vec2::new(0.3, 0.5)), Vec3::X);
+    assert_eq!(
+        Texture::sample_pair(&set, &b, uv),
+        (b.sample(in_tile), b.sample(uv))
+    );
+    assert_eq!(
+        Texture::sample_pair(&b, &set, uv),
+        (b.sample(uv), b.sample(in_tile))
+    );
+    assert!(Texture::udim("s", vec![(1001, a.clone()), (1001, a)]).is_none());
+}

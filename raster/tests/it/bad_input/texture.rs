@@ -217,3 +217,72 @@ fn texture_on_mesh_without_uvs() {
     );
     sb.succeeds(&render(&[]));
 }
+
+/// A square facing the camera whose UVs all lie in UDIM tile 1002 (u in [1.05, 1.95]).
+const QUAD_IN_TILE_1002: &[u8] = b"v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0.5 0 0.5\nv -0.5 0 0.5\n\
+vt 1.05 0.05\nvt 1.95 0.05\nvt 1.95 0.95\nvt 1.05 0.95\nvn 0 -1 0\n\
+f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+
+/// A UDIM set: each point reads the tile its UVs fall in. On a square whose UVs lie in tile
+/// 1002 the set renders the bytes of tile 1002's file alone (a single texture repeats, so the
+/// same texels and weights), and not those of tile 1001's. The two tiles hold the same codes
+/// in reverse order, so that K_d spans the same range either way.
+#[test]
+fn udim_sets_read_each_points_tile() {
+    let with_kd = |file: &str| scene("obj = \"quad.obj\"", &KD_TEXTURE.replace("kd.png", file));
+    let sb = Sandbox::with_scene("texture-udim", &with_kd("kd.<UDIM>.png"));
+    sb.write("quad.obj", QUAD_IN_TILE_1002);
+    let codes: Vec<u8> = (0..16u8)
+        .flat_map(|i| [40 + 12 * i, 200 - 9 * i, 90 + (i % 4) * 30])
+        .collect();
+    let reversed: Vec<u8> = codes.chunks_exact(3).rev().flatten().copied().collect();
+    let png = |name: &str, rgb: &[u8]| {
+        lucent_raster::output::png::write_png_rgb8(&sb.path(name), 4, 4, rgb).expect("write a tile")
+    };
+    png("kd.1002.png", &codes);
+    png("kd.1001.png", &reversed);
+    // Not tiles of the set: no four-digit number, or not a tile's.
+    png("kd.1000.png", &reversed);
+    png("kd.102.png", &reversed);
+    let image = |file: &str| {
+        sb.write("scene.toml", with_kd(file).as_bytes());
+        sb.succeeds(&render(&[]));
+        sb.read("out.png")
+    };
+    let set = image("kd.<UDIM>.png");
+    assert_eq!(set, image("kd.1002.png"), "the set against its tile 1002");
+    assert_ne!(set, image("kd.1001.png"), "the set against its tile 1001");
+}
+
+/// A UDIM set without a tile, with the token in a folder's name, or as an environment map
+/// (one latitude-longitude image) is refused, naming it.
+#[test]
+fn udim_sets_that_cannot_be_used() {
+    let udim = KD_TEXTURE.replace("kd.png", "kd.<UDIM>.png");
+    let sb = Sandbox::with_scene("texture-udim-bad", &scene(SPHERE, &udim));
+    valid_png(&sb, "kd.png", 4, 4);
+    valid_png(&sb, "kd.1000.png", 4, 4);
+    sb.fails(
+        &render(&[]),
+        1,
+        &[
+            "material.m.kd.texture",
+            "no file matches the UDIM set",
+            "kd.<UDIM>.png (tiles 1001 to 1100)",
+        ],
+    );
+    let in_folder = KD_TEXTURE.replace("kd.png", "t<UDIM>/kd.png");
+    sb.write("scene.toml", scene(SPHERE, &in_folder).as_bytes());
+    sb.fails(&render(&[]), 1, &["<UDIM> must be in the file name"]);
+    valid_png(&sb, "sky.1001.png", 4, 2);
+    let sky = format!(
+        "{}\n[[light]]\ntype = \"environment\"\nmap = \"sky.<UDIM>.png\"\n",
+        scene(SPHERE, CONSTANT)
+    );
+    sb.write("scene.toml", sky.as_bytes());
+    sb.fails(
+        &render(&[]),
+        1,
+        &["map", "a UDIM set is not a latitude-longitude map"],
+    );
+}
