@@ -304,7 +304,7 @@ mod tests {
     }
 
     #[test]
-    fn only_scenes_from_clustered_from_triangles_are_clustered() {
+    fn only_scenes_of_at_least_clustered_from_triangles_are_clustered() {
         assert_eq!(cluster_size(0), 1);
         assert_eq!(cluster_size(CLUSTERED_FROM - 1), 1);
         assert_eq!(cluster_size(CLUSTERED_FROM), CLUSTER);
