@@ -105,9 +105,7 @@ impl SceneOrigin {
             }
         }
     }
-}
 
-impl SceneOrigin {
     /// The files of the UDIM set `pattern` (a scene-relative path whose file name holds
     /// [`UDIM_TOKEN`]): each tile number with the file's scene-relative path, in increasing
     /// tile number. Errors if the token is not in the file name or the folder cannot be listed.
